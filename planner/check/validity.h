@@ -1,0 +1,57 @@
+#pragma once
+// The validity contract of DESIGN.md section 9, checked part by part for one
+// posture and its stance. Each part reports what it checked, its worst figure
+// and every violation with its figure.
+//
+// Equilibrium is not checked here yet: it arrives with the independent
+// quasi-static check (posture-generator issue), and the report says so.
+#include <string>
+#include <vector>
+
+#include "planner/collision/collision_model.h"
+#include "planner/model/kinematics.h"
+#include "planner/scene/scenario.h"
+
+namespace acyclic {
+
+struct ContractTolerances {
+  double contact_position = 1e-3;    // m: spot origin to the contact point
+  double contact_normal_deg = 1.0;   // deg: between spot and surface normals
+  double polygon = 1e-3;             // m: spot polygon corners outside the surface polygon
+  double penetration = 1e-3;         // m: allowed for a contacting body on its own surface's obstacle
+  double joint_limit = 1e-9;         // rad: numerical slack on joint limits
+};
+
+struct CheckPart {
+  std::string name;                  // "joint limits", "contacts", "collisions", "equilibrium"
+  bool checked = true;               // false: not available (says why in summary)
+  std::vector<std::string> violations;
+  std::string summary;               // what was checked and the worst figure
+  bool ok() const { return violations.empty(); }
+};
+
+struct ValidityReport {
+  std::vector<CheckPart> parts;
+  bool valid() const;                // every checked part ok
+};
+
+class ValidityChecker {
+ public:
+  ValidityChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                  ContractTolerances tol = {});
+
+  ValidityReport checkPosture(const Configuration& q, const std::vector<ContactSpec>& stance);
+
+  CheckPart checkJointLimits(const Configuration& q) const;
+  CheckPart checkContacts(const std::vector<ContactSpec>& stance);    // at the last set configuration
+  CheckPart checkCollisions(const std::vector<ContactSpec>& stance);  // idem
+
+ private:
+  std::shared_ptr<const RobotModel> robot_;
+  std::shared_ptr<const Scene> scene_;
+  ContractTolerances tol_;
+  Kinematics kin_;
+  CollisionModel collision_;
+};
+
+}  // namespace acyclic

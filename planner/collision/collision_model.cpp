@@ -1,0 +1,179 @@
+#include "planner/collision/collision_model.h"
+
+#include <cmath>
+
+#include <fcl/narrowphase/distance.h>
+
+namespace acyclic {
+
+namespace {
+
+std::shared_ptr<fcl::CollisionGeometryd> makeGeometry(const CollisionShape& s) {
+  std::shared_ptr<fcl::CollisionGeometryd> g;
+  switch (s.kind) {
+    case CollisionShape::Kind::Box:
+      g = std::make_shared<fcl::Boxd>(s.size.x(), s.size.y(), s.size.z());
+      break;
+    case CollisionShape::Kind::Capsule:
+      g = std::make_shared<fcl::Capsuled>(s.radius, s.length);
+      break;
+    case CollisionShape::Kind::Cylinder:
+      g = std::make_shared<fcl::Cylinderd>(s.radius, s.length);
+      break;
+    case CollisionShape::Kind::Sphere:
+      g = std::make_shared<fcl::Sphered>(s.radius);
+      break;
+  }
+  g->computeLocalAABB();
+  return g;
+}
+
+// Radius of a sphere about the shape's origin that contains it.
+double boundingRadius(const CollisionShape& s) {
+  switch (s.kind) {
+    case CollisionShape::Kind::Box: return 0.5 * s.size.norm();
+    case CollisionShape::Kind::Capsule: return 0.5 * s.length + s.radius;
+    case CollisionShape::Kind::Cylinder: return std::hypot(0.5 * s.length, s.radius);
+    case CollisionShape::Kind::Sphere: return s.radius;
+  }
+  return 0;
+}
+
+}  // namespace
+
+struct CollisionModel::Geometry {
+  // robot[link][shape], obstacles[i]
+  std::vector<std::vector<std::shared_ptr<fcl::CollisionGeometryd>>> robot;
+  std::vector<std::vector<double>> robot_radius;
+  std::vector<std::shared_ptr<fcl::CollisionGeometryd>> obstacles;
+  std::vector<fcl::AABBd> obstacle_aabb;  // world
+};
+
+CollisionModel::CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
+    : robot_(std::move(robot)), scene_(std::move(scene)), geom_(std::make_unique<Geometry>()) {
+  const auto& links = robot_->links();
+  geom_->robot.resize(links.size());
+  geom_->robot_radius.resize(links.size());
+  for (const auto& l : links)
+    for (const auto& s : l.shapes) {
+      geom_->robot[l.index].push_back(makeGeometry(s));
+      geom_->robot_radius[l.index].push_back(boundingRadius(s));
+    }
+  for (const auto& o : scene_->obstacles()) geom_->obstacles.push_back(makeGeometry(o.shape));
+  for (std::size_t i = 0; i < scene_->obstacles().size(); ++i) {
+    // World AABB: transform the local AABB's corners.
+    const auto& local = geom_->obstacles[i]->aabb_local;
+    const Eigen::Isometry3d& T = scene_->obstacles()[i].shape.pose;
+    fcl::AABBd world;
+    bool first = true;
+    for (int c = 0; c < 8; ++c) {
+      Eigen::Vector3d p((c & 1) ? local.max_.x() : local.min_.x(), (c & 2) ? local.max_.y() : local.min_.y(),
+                        (c & 4) ? local.max_.z() : local.min_.z());
+      p = T * p;
+      if (first) world = fcl::AABBd(p), first = false;
+      else world += p;
+    }
+    geom_->obstacle_aabb.push_back(world);
+  }
+
+  // Robot-environment: every robot shape against every obstacle.
+  for (const auto& l : links)
+    for (std::size_t s = 0; s < l.shapes.size(); ++s)
+      for (std::size_t o = 0; o < scene_->obstacles().size(); ++o) {
+        CollisionPair p;
+        p.kind = CollisionPair::Kind::RobotEnvironment;
+        p.link_a = l.index;
+        p.shape_a = static_cast<int>(s);
+        p.obstacle = static_cast<int>(o);
+        pairs_.push_back(p);
+      }
+  n_env_ = static_cast<int>(pairs_.size());
+  // Self: every shape pair of the listed link pairs.
+  for (const auto& [a, b] : robot_->selfCollisionPairs())
+    for (std::size_t sa = 0; sa < links[a].shapes.size(); ++sa)
+      for (std::size_t sb = 0; sb < links[b].shapes.size(); ++sb) {
+        CollisionPair p;
+        p.kind = CollisionPair::Kind::Self;
+        p.link_a = a;
+        p.shape_a = static_cast<int>(sa);
+        p.link_b = b;
+        p.shape_b = static_cast<int>(sb);
+        pairs_.push_back(p);
+      }
+}
+
+CollisionModel::~CollisionModel() = default;
+
+std::string CollisionModel::describe(int i) const {
+  const CollisionPair& p = pairs_.at(i);
+  const auto& la = robot_->links()[p.link_a];
+  std::string a = la.name + "/" + la.shapes[p.shape_a].name;
+  if (p.kind == CollisionPair::Kind::RobotEnvironment) return a + " ~ " + scene_->obstacles()[p.obstacle].name;
+  const auto& lb = robot_->links()[p.link_b];
+  return a + " ~ " + lb.name + "/" + lb.shapes[p.shape_b].name;
+}
+
+std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const DistanceOptions& opt) const {
+  const auto& links = robot_->links();
+  std::vector<Eigen::Isometry3d> link_pose(links.size());
+  for (const auto& l : links)
+    if (!l.shapes.empty()) link_pose[l.index] = kin.linkPose(l.index);
+
+  fcl::DistanceRequestd req(true, true);  // nearest points, signed distance
+  req.gjk_solver_type = fcl::GST_LIBCCD;
+  std::vector<PairDistance> out;
+  out.reserve(pairs_.size());
+
+  for (int i = 0; i < static_cast<int>(pairs_.size()); ++i) {
+    const CollisionPair& p = pairs_[i];
+    const CollisionShape& sa = links[p.link_a].shapes[p.shape_a];
+    const Eigen::Isometry3d Ta = link_pose[p.link_a] * sa.pose;
+    const fcl::CollisionGeometryd* ga = geom_->robot[p.link_a][p.shape_a].get();
+    const double ra = geom_->robot_radius[p.link_a][p.shape_a];
+    const fcl::CollisionGeometryd* gb;
+    Eigen::Isometry3d Tb;
+    double lower_bound;
+    if (p.kind == CollisionPair::Kind::RobotEnvironment) {
+      gb = geom_->obstacles[p.obstacle].get();
+      Tb = scene_->obstacles()[p.obstacle].shape.pose;
+      const fcl::AABBd& box = geom_->obstacle_aabb[p.obstacle];
+      const Eigen::Vector3d c = Ta.translation();
+      const Eigen::Vector3d q = c.cwiseMax(box.min_).cwiseMin(box.max_);
+      lower_bound = (c - q).norm() - ra;
+    } else {
+      const CollisionShape& sb = links[p.link_b].shapes[p.shape_b];
+      Tb = link_pose[p.link_b] * sb.pose;
+      gb = geom_->robot[p.link_b][p.shape_b].get();
+      lower_bound = (Ta.translation() - Tb.translation()).norm() - ra - geom_->robot_radius[p.link_b][p.shape_b];
+    }
+    if (lower_bound > opt.cutoff) continue;
+
+    fcl::DistanceResultd res;
+    fcl::distance(ga, fcl::Transform3d(Ta.matrix()), gb, fcl::Transform3d(Tb.matrix()), req, res);
+    PairDistance d;
+    d.pair = i;
+    d.distance = res.min_distance;
+    d.point_a = res.nearest_points[0];
+    d.point_b = res.nearest_points[1];
+    if (opt.gradients) {
+      // d = n . (pb - pa) with n = (pb - pa) / d for either sign of d, so
+      // grad d = n^T (J_b(pb) - J_a(pa)). At contact (d ~ 0) the witness
+      // points coincide; the line between the shapes' centres stands in for n.
+      Eigen::Vector3d n;
+      if (std::abs(d.distance) > 1e-9 && (d.point_b - d.point_a).norm() > 1e-9)
+        n = (d.point_b - d.point_a) / d.distance;
+      else
+        n = (Tb.translation() - Ta.translation()).normalized();
+      const Eigen::Vector3d pa_local = link_pose[p.link_a].inverse() * d.point_a;
+      d.gradient = -(n.transpose() * kin.pointJacobian(p.link_a, pa_local)).transpose();
+      if (p.kind == CollisionPair::Kind::Self) {
+        const Eigen::Vector3d pb_local = link_pose[p.link_b].inverse() * d.point_b;
+        d.gradient += (n.transpose() * kin.pointJacobian(p.link_b, pb_local)).transpose();
+      }
+    }
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+}  // namespace acyclic

@@ -1,0 +1,61 @@
+#pragma once
+// Signed distances between the robot and the scene and between listed robot
+// links, with witness points and gradients (FCL for the geometry, Simbody
+// Jacobians for the derivatives). DESIGN.md sections 5 and 6.
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "planner/model/kinematics.h"
+#include "planner/scene/scene.h"
+
+namespace acyclic {
+
+struct CollisionPair {
+  enum class Kind { RobotEnvironment, Self };
+  Kind kind = Kind::RobotEnvironment;
+  int link_a = -1, shape_a = -1;   // robot link and its shape index
+  int link_b = -1, shape_b = -1;   // Self: second robot link and shape
+  int obstacle = -1;               // RobotEnvironment: the obstacle
+};
+
+struct PairDistance {
+  int pair = -1;
+  double distance = 0;             // signed, m: negative when penetrating
+  Eigen::Vector3d point_a, point_b;  // world witness points on a and on b
+  Eigen::VectorXd gradient;        // d distance / d configuration (tangent); empty unless asked
+};
+
+struct DistanceOptions {
+  bool gradients = false;
+  // Pairs certainly farther apart than this (by bounding volumes) are skipped.
+  double cutoff = std::numeric_limits<double>::infinity();
+};
+
+class CollisionModel {
+ public:
+  CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene);
+  ~CollisionModel();
+
+  const std::vector<CollisionPair>& pairs() const { return pairs_; }
+  std::string describe(int pair) const;  // "RLEG_LINK2/capsule_thigh ~ chair_seat"
+  int numRobotEnvironmentPairs() const { return n_env_; }
+  int numSelfPairs() const { return static_cast<int>(pairs_.size()) - n_env_; }
+
+  // Distances of every pair (within the cutoff) at the kinematics' configuration.
+  // Thread-safe: the model is read-only; use one Kinematics per thread.
+  std::vector<PairDistance> distances(const Kinematics& kin, const DistanceOptions& opt = {}) const;
+
+ private:
+  struct Geometry;
+  std::shared_ptr<const RobotModel> robot_;
+  std::shared_ptr<const Scene> scene_;
+  std::vector<CollisionPair> pairs_;
+  int n_env_ = 0;
+  std::unique_ptr<Geometry> geom_;
+};
+
+}  // namespace acyclic

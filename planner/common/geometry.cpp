@@ -1,0 +1,93 @@
+#include "planner/common/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace acyclic {
+
+Eigen::Quaterniond rpyToQuaternion(const Eigen::Vector3d& rpy) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                            Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()));
+}
+
+Eigen::Vector3d quaternionToRpy(const Eigen::Quaterniond& q) {
+  const Eigen::Matrix3d R = q.toRotationMatrix();
+  double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  double roll = std::atan2(R(2, 1), R(2, 2));
+  double yaw = std::atan2(R(1, 0), R(0, 0));
+  return {roll, pitch, yaw};
+}
+
+Eigen::Matrix3d expSO3(const Eigen::Vector3d& w) {
+  double a = w.norm();
+  if (a < 1e-12) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(a, w / a).toRotationMatrix();
+}
+
+Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
+  Eigen::AngleAxisd aa(R);
+  return aa.axis() * aa.angle();
+}
+
+ConvexPolygon::ConvexPolygon(std::vector<Eigen::Vector2d> v) : v_(std::move(v)) {
+  const std::size_t n = v_.size();
+  if (n < 3) throw std::invalid_argument("a polygon needs at least 3 vertices");
+  double a2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& p = v_[i];
+    const auto& q = v_[(i + 1) % n];
+    a2 += p.x() * q.y() - q.x() * p.y();
+  }
+  if (std::abs(a2) < 1e-12) throw std::invalid_argument("the polygon has zero area");
+  if (a2 < 0) std::reverse(v_.begin(), v_.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d e1 = v_[(i + 1) % n] - v_[i];
+    Eigen::Vector2d e2 = v_[(i + 2) % n] - v_[(i + 1) % n];
+    if (e1.norm() < 1e-12) throw std::invalid_argument("the polygon repeats a vertex");
+    if (e1.x() * e2.y() - e1.y() * e2.x() < -1e-12)
+      throw std::invalid_argument("the polygon is not convex (vertex " + std::to_string((i + 1) % n) + ")");
+  }
+}
+
+double ConvexPolygon::signedDistance(const Eigen::Vector2d& p) const {
+  const std::size_t n = v_.size();
+  double max_out = -std::numeric_limits<double>::infinity();  // max signed edge distance
+  double min_edge = std::numeric_limits<double>::infinity();  // exact distance to the boundary
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d a = v_[i], b = v_[(i + 1) % n];
+    const Eigen::Vector2d e = b - a;
+    const Eigen::Vector2d outward(e.y(), -e.x());
+    max_out = std::max(max_out, outward.normalized().dot(p - a));
+    double t = std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+    min_edge = std::min(min_edge, (a + t * e - p).norm());
+  }
+  return max_out > 0 ? min_edge : -min_edge;
+}
+
+double ConvexPolygon::area() const {
+  double a2 = 0;
+  for (std::size_t i = 0; i < v_.size(); ++i) {
+    const auto& p = v_[i];
+    const auto& q = v_[(i + 1) % v_.size()];
+    a2 += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * a2;
+}
+
+Eigen::Vector2d ConvexPolygon::centroid() const {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  double a2 = 0;
+  for (std::size_t i = 0; i < v_.size(); ++i) {
+    const auto& p = v_[i];
+    const auto& q = v_[(i + 1) % v_.size()];
+    double cr = p.x() * q.y() - q.x() * p.y();
+    a2 += cr;
+    c += (p + q) * cr;
+  }
+  return c / (3.0 * a2);
+}
+
+}  // namespace acyclic

@@ -1,0 +1,41 @@
+#pragma once
+// Small geometric helpers shared by the model, the scene and the checks.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+namespace acyclic {
+
+// Roll-pitch-yaw (rotations about fixed x, then y, then z: R = Rz Ry Rx), as in URDF.
+Eigen::Quaterniond rpyToQuaternion(const Eigen::Vector3d& rpy);
+Eigen::Vector3d quaternionToRpy(const Eigen::Quaterniond& q);
+
+// Rotation vector (axis times angle) to rotation and back.
+Eigen::Matrix3d expSO3(const Eigen::Vector3d& w);
+Eigen::Vector3d logSO3(const Eigen::Matrix3d& R);
+
+// A convex polygon in a plane, vertices counter-clockwise.
+class ConvexPolygon {
+ public:
+  ConvexPolygon() = default;
+  // Throws std::invalid_argument (with the reason) when the vertices do not
+  // form a convex polygon with positive area; clockwise input is reversed.
+  explicit ConvexPolygon(std::vector<Eigen::Vector2d> vertices);
+
+  const std::vector<Eigen::Vector2d>& vertices() const { return v_; }
+  std::size_t size() const { return v_.size(); }
+  // Signed distance from p to the boundary: negative inside, positive outside
+  // (exact outside, minus the distance to the nearest edge inside).
+  double signedDistance(const Eigen::Vector2d& p) const;
+  bool contains(const Eigen::Vector2d& p, double tolerance = 0.0) const {
+    return signedDistance(p) <= tolerance;
+  }
+  double area() const;
+  Eigen::Vector2d centroid() const;
+
+ private:
+  std::vector<Eigen::Vector2d> v_;
+};
+
+}  // namespace acyclic

@@ -1,0 +1,168 @@
+#include "planner/common/yaml_field.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "planner/common/geometry.h"
+
+namespace acyclic {
+
+YamlField YamlField::loadFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FormatError(path, "", "cannot open the file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return loadText(ss.str(), path);
+}
+
+YamlField YamlField::loadText(const std::string& text, const std::string& origin) {
+  try {
+    YAML::Node n = YAML::Load(text);
+    if (!n.IsMap()) throw FormatError(origin, "", "expected a YAML map at the top level");
+    return YamlField(n, origin, "");
+  } catch (const YAML::Exception& e) {
+    throw FormatError(origin, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) +
+                                      "): " + e.msg);
+  }
+}
+
+std::string YamlField::describe() const {
+  if (!node_.IsDefined() || node_.IsNull()) return "nothing";
+  if (node_.IsScalar()) return "'" + node_.Scalar() + "'";
+  if (node_.IsSequence()) return "a list of " + std::to_string(node_.size());
+  return "a map";
+}
+
+void YamlField::fail(const std::string& expected) const {
+  throw FormatError(file_, path_, "expected " + expected + ", got " + describe());
+}
+
+bool YamlField::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
+}
+
+YamlField YamlField::operator[](const std::string& key) const {
+  if (!node_.IsMap()) fail("a map with a field '" + key + "'");
+  std::string child = path_.empty() ? key : path_ + "." + key;
+  YAML::Node n = node_[key];
+  if (!n.IsDefined() || n.IsNull())
+    throw FormatError(file_, child, "missing (required)");
+  return YamlField(n, file_, child);
+}
+
+YamlField YamlField::at(std::size_t i) const {
+  if (!node_.IsSequence()) fail("a list");
+  if (i >= node_.size()) fail("at least " + std::to_string(i + 1) + " elements");
+  return YamlField(node_[i], file_, path_ + "[" + std::to_string(i) + "]");
+}
+
+std::size_t YamlField::size() const {
+  if (!node_.IsSequence()) fail("a list");
+  return node_.size();
+}
+
+std::vector<std::string> YamlField::keys() const {
+  if (!node_.IsMap()) fail("a map");
+  std::vector<std::string> out;
+  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
+double YamlField::number() const {
+  if (!node_.IsScalar()) fail("a number");
+  double v;
+  if (!YAML::convert<double>::decode(node_, v) || !std::isfinite(v)) fail("a finite number");
+  return v;
+}
+
+int YamlField::integer() const {
+  if (!node_.IsScalar()) fail("an integer");
+  int v;
+  if (!YAML::convert<int>::decode(node_, v)) fail("an integer");
+  return v;
+}
+
+bool YamlField::boolean() const {
+  if (!node_.IsScalar()) fail("true or false");
+  bool v;
+  if (!YAML::convert<bool>::decode(node_, v)) fail("true or false");
+  return v;
+}
+
+std::string YamlField::string() const {
+  if (!node_.IsScalar()) fail("a string");
+  return node_.Scalar();
+}
+
+std::vector<std::string> YamlField::strings() const {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < size(); ++i) out.push_back(at(i).string());
+  return out;
+}
+
+std::vector<double> YamlField::numbers() const {
+  std::vector<double> out;
+  for (std::size_t i = 0; i < size(); ++i) out.push_back(at(i).number());
+  return out;
+}
+
+std::vector<double> YamlField::numbers(std::size_t n) const {
+  if (!node_.IsSequence() || node_.size() != n) fail("a list of " + std::to_string(n) + " numbers");
+  return numbers();
+}
+
+Eigen::Vector3d YamlField::vec3() const {
+  auto v = numbers(3);
+  return {v[0], v[1], v[2]};
+}
+
+Eigen::Vector2d YamlField::vec2() const {
+  auto v = numbers(2);
+  return {v[0], v[1]};
+}
+
+void YamlField::allowOnly(const std::vector<std::string>& allowed) const {
+  for (const auto& k : keys()) {
+    bool ok = false;
+    for (const auto& a : allowed) ok = ok || a == k;
+    if (!ok) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw FormatError(file_, path_.empty() ? k : path_ + "." + k,
+                        "unknown field (expected one of: " + list + ")");
+    }
+  }
+}
+
+void YamlField::requireFormat(const std::string& expected) const {
+  if (!has("format")) throw FormatError(file_, "format", "missing: expected '" + expected + "'");
+  std::string got = (*this)["format"].string();
+  if (got != expected) (*this)["format"].fail("'" + expected + "'");
+}
+
+Eigen::Quaterniond readOrientation(const YamlField& parent) {
+  int count = parent.has("rpy") + parent.has("rpy_deg") + parent.has("quaternion");
+  if (count > 1)
+    throw FormatError(parent.file(), parent.path(),
+                      "give at most one of rpy, rpy_deg, quaternion");
+  if (parent.has("rpy")) return rpyToQuaternion(parent["rpy"].vec3());
+  if (parent.has("rpy_deg")) return rpyToQuaternion(parent["rpy_deg"].vec3() * M_PI / 180.0);
+  if (parent.has("quaternion")) {
+    auto v = parent["quaternion"].numbers(4);
+    Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
+    if (std::abs(q.norm() - 1.0) > 1e-6)
+      parent["quaternion"].fail("a unit quaternion [w, x, y, z] (norm 1 within 1e-6)");
+    return q.normalized();
+  }
+  return Eigen::Quaterniond::Identity();
+}
+
+Eigen::Isometry3d readPose(const YamlField& parent) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (parent.has("position")) T.translation() = parent["position"].vec3();
+  T.linear() = readOrientation(parent).toRotationMatrix();
+  return T;
+}
+
+}  // namespace acyclic

@@ -1,0 +1,68 @@
+#pragma once
+// A YAML node that knows which file and field it came from, so that every
+// error about it names both (DESIGN.md section 5).
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+#include <yaml-cpp/yaml.h>
+
+#include "planner/common/format_error.h"
+
+namespace acyclic {
+
+class YamlField {
+ public:
+  // Loads a file; a missing file or a YAML syntax error is a FormatError.
+  static YamlField loadFile(const std::string& path);
+  // Parses text that came from `origin` (a file name or a message description).
+  static YamlField loadText(const std::string& text, const std::string& origin);
+
+  YamlField(YAML::Node node, std::string file, std::string path)
+      : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+  const YAML::Node& node() const { return node_; }
+
+  bool has(const std::string& key) const;
+  YamlField operator[](const std::string& key) const;  // required member of a map
+  YamlField at(std::size_t i) const;                   // element of a sequence
+  std::size_t size() const;                            // sequence length (requires a sequence)
+  std::vector<std::string> keys() const;               // map keys in file order (requires a map)
+
+  bool isMap() const { return node_.IsMap(); }
+  bool isSequence() const { return node_.IsSequence(); }
+  bool isScalar() const { return node_.IsScalar(); }
+
+  double number() const;
+  int integer() const;
+  bool boolean() const;
+  std::string string() const;
+  std::vector<std::string> strings() const;
+  std::vector<double> numbers() const;                 // any length
+  std::vector<double> numbers(std::size_t n) const;    // exactly n
+  Eigen::Vector3d vec3() const;
+  Eigen::Vector2d vec2() const;
+
+  // Rejects keys not in `allowed` (a typo should not be silently ignored).
+  void allowOnly(const std::vector<std::string>& allowed) const;
+  // Requires `format: <expected>` at this (top-level) node.
+  void requireFormat(const std::string& expected) const;
+
+  [[noreturn]] void fail(const std::string& expected) const;
+
+ private:
+  std::string describe() const;
+  YAML::Node node_;
+  std::string file_;
+  std::string path_;
+};
+
+// An orientation from a map that holds exactly one of: rpy (rad), rpy_deg,
+// or quaternion [w, x, y, z]; identity when none is present.
+Eigen::Quaterniond readOrientation(const YamlField& parent);
+// A pose: position (default zero) plus orientation as above.
+Eigen::Isometry3d readPose(const YamlField& parent);
+
+}  // namespace acyclic

@@ -1,0 +1,130 @@
+#include "planner/model/kinematics.h"
+
+#include <stdexcept>
+
+#include "planner/model/simbody_impl.h"
+
+namespace acyclic {
+
+struct Kinematics::State {
+  SimTK::State s;
+  SimTK::Matrix scratch;
+};
+
+namespace {
+SimTK::Vec3 toVec3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3d toEigen(const SimTK::Vec3& v) { return {v[0], v[1], v[2]}; }
+}  // namespace
+
+Kinematics::Kinematics(std::shared_ptr<const RobotModel> model)
+    : model_(std::move(model)), state_(std::make_unique<State>()) {
+  state_->s = model_->impl().default_state;
+  setConfiguration(model_->zeroConfiguration());
+}
+
+Kinematics::~Kinematics() = default;
+
+void Kinematics::setConfiguration(const Configuration& q) {
+  const auto& S = model_->impl();
+  if (q.joints.size() != model_->numJoints())
+    throw std::invalid_argument("Kinematics: configuration has " + std::to_string(q.joints.size()) +
+                                " joints, the model " + std::to_string(model_->numJoints()));
+  q_ = q;
+  const Eigen::Quaterniond o = q.base_orientation.normalized();
+  SimTK::Transform X(SimTK::Rotation(SimTK::Quaternion(o.w(), o.x(), o.y(), o.z())), toVec3(q.base_position));
+  S.matter.getMobilizedBody(S.base_mobod).setQToFitTransform(state_->s, X);
+  SimTK::Vector& Q = state_->s.updQ();
+  for (int j = 0; j < model_->numJoints(); ++j) Q[S.q_of_joint[j]] = q.joints[j];
+  S.system.realize(state_->s, SimTK::Stage::Position);
+}
+
+Eigen::Isometry3d Kinematics::linkPose(int link) const {
+  const auto& S = model_->impl();
+  const SimTK::Transform& X = S.matter.getMobilizedBody(S.link_mobod.at(link)).getBodyTransform(state_->s);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) T.linear()(i, k) = X.R().asMat33()(i, k);
+  T.translation() = toEigen(X.p());
+  return T;
+}
+
+Eigen::Isometry3d Kinematics::spotPose(int spot) const {
+  const ContactSpot& s = model_->spots().at(spot);
+  return linkPose(s.link) * s.frame;
+}
+
+Eigen::MatrixXd Kinematics::pointJacobian(int link, const Eigen::Vector3d& p) const {
+  const auto& S = model_->impl();
+  S.matter.calcStationJacobian(state_->s, S.link_mobod.at(link), toVec3(p), state_->scratch);
+  const SimTK::Matrix& J = state_->scratch;
+  Eigen::MatrixXd out(3, model_->tangentSize());
+  for (int u = 0; u < J.ncol(); ++u) {
+    const int t = S.tangent_of_u[u];
+    for (int r = 0; r < 3; ++r) out(r, t) = J(r, u);
+  }
+  return out;
+}
+
+Eigen::MatrixXd Kinematics::frameJacobian(int link, const Eigen::Vector3d& origin) const {
+  const auto& S = model_->impl();
+  S.matter.calcFrameJacobian(state_->s, S.link_mobod.at(link), toVec3(origin), state_->scratch);
+  const SimTK::Matrix& J = state_->scratch;  // rows: angular(3), linear(3)
+  Eigen::MatrixXd out(6, model_->tangentSize());
+  for (int u = 0; u < J.ncol(); ++u) {
+    const int t = S.tangent_of_u[u];
+    for (int r = 0; r < 3; ++r) {
+      out(r, t) = J(3 + r, u);
+      out(3 + r, t) = J(r, u);
+    }
+  }
+  return out;
+}
+
+Eigen::Vector3d Kinematics::centerOfMass() const {
+  const auto& S = model_->impl();
+  return toEigen(S.matter.calcSystemMassCenterLocationInGround(state_->s));
+}
+
+Eigen::MatrixXd Kinematics::centerOfMassJacobian() const {
+  // Simbody has no system mass-centre Jacobian: row k is J^T applied to the
+  // forces (m_i / M) e_k at each link's centre of mass, one O(n) pass per row.
+  const auto& S = model_->impl();
+  const double M = model_->totalMass();
+  Eigen::MatrixXd out(3, model_->tangentSize());
+  SimTK::Vector_<SimTK::SpatialVec> F(S.matter.getNumBodies());
+  SimTK::Vector f;
+  for (int k = 0; k < 3; ++k) {
+    F = SimTK::SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0));
+    SimTK::Vec3 e(0);
+    e[k] = 1.0;
+    for (const auto& l : model_->links()) {
+      const auto& mb = S.matter.getMobilizedBody(S.link_mobod[l.index]);
+      const SimTK::Vec3 r = mb.getBodyRotation(state_->s) * toVec3(l.com);
+      const SimTK::Vec3 force = (l.mass / M) * e;
+      F[mb.getMobilizedBodyIndex()] = SimTK::SpatialVec(r % force, force);
+    }
+    S.matter.multiplyBySystemJacobianTranspose(state_->s, F, f);
+    for (int u = 0; u < f.size(); ++u) out(k, S.tangent_of_u[u]) = f[u];
+  }
+  return out;
+}
+
+Eigen::VectorXd Kinematics::gravityTorques() const {
+  const auto& S = model_->impl();
+  const int nb = S.matter.getNumBodies();
+  SimTK::Vector_<SimTK::SpatialVec> F(nb, SimTK::SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
+  const SimTK::Vec3 g = toVec3(S.gravity);
+  for (const auto& l : model_->links()) {
+    const auto& mb = S.matter.getMobilizedBody(S.link_mobod[l.index]);
+    const SimTK::Vec3 r = mb.getBodyRotation(state_->s) * toVec3(l.com);  // origin -> com, ground axes
+    const SimTK::Vec3 f = l.mass * g;
+    F[mb.getMobilizedBodyIndex()] = SimTK::SpatialVec(r % f, f);
+  }
+  SimTK::Vector f;
+  S.matter.multiplyBySystemJacobianTranspose(state_->s, F, f);
+  Eigen::VectorXd out(model_->tangentSize());
+  for (int u = 0; u < f.size(); ++u) out[S.tangent_of_u[u]] = -f[u];
+  return out;
+}
+
+}  // namespace acyclic

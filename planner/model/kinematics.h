@@ -1,0 +1,51 @@
+#pragma once
+// Per-thread evaluation of a RobotModel at one configuration: world poses,
+// Jacobians, centre of mass, gravity torques (Simbody underneath).
+//
+// Jacobians are with respect to the tangent space of Configuration
+// (configuration.h): columns [translation(3), rotation(3), joints(n)].
+// A frame Jacobian's rows are [linear velocity(3); angular velocity(3)],
+// world frame. One Kinematics per thread; the model is shared.
+#include <memory>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "planner/model/robot_model.h"
+
+namespace acyclic {
+
+class Kinematics {
+ public:
+  explicit Kinematics(std::shared_ptr<const RobotModel> model);
+  ~Kinematics();
+  Kinematics(const Kinematics&) = delete;
+  Kinematics& operator=(const Kinematics&) = delete;
+
+  const RobotModel& model() const { return *model_; }
+  const std::shared_ptr<const RobotModel>& modelPtr() const { return model_; }
+
+  void setConfiguration(const Configuration& q);
+  const Configuration& configuration() const { return q_; }
+
+  Eigen::Isometry3d linkPose(int link) const;
+  Eigen::Isometry3d spotPose(int spot) const;
+  // Jacobian (3 x tangent) of a point fixed on a link, given in link coordinates.
+  Eigen::MatrixXd pointJacobian(int link, const Eigen::Vector3d& point_in_link) const;
+  // Jacobian (6 x tangent) of a frame fixed on a link, origin given in link coordinates.
+  Eigen::MatrixXd frameJacobian(int link, const Eigen::Vector3d& origin_in_link) const;
+  Eigen::Vector3d centerOfMass() const;
+  Eigen::MatrixXd centerOfMassJacobian() const;  // 3 x tangent
+  // Generalized forces that hold the robot still against gravity, g(q): the
+  // tangent-space vector such that equilibrium reads  tau + sum J^T f = g(q).
+  // Entries [0, 6) are the base's (force, moment about the base origin, world).
+  Eigen::VectorXd gravityTorques() const;
+
+ private:
+  struct State;
+  std::shared_ptr<const RobotModel> model_;
+  std::unique_ptr<State> state_;
+  Configuration q_;
+};
+
+}  // namespace acyclic

@@ -1,0 +1,137 @@
+#include "planner/scene/scenario.h"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "planner/common/yaml_field.h"
+#include "planner/model/kinematics.h"
+
+namespace acyclic {
+namespace fs = std::filesystem;
+
+bool GoalCondition::satisfied(const Kinematics& k) const {
+  const double v = k.linkPose(link).translation()[axis];
+  return v >= min && v <= max;
+}
+
+std::string GoalCondition::describe(const RobotModel& m) const {
+  std::ostringstream os;
+  os << m.links()[link].name << "." << "xyz"[axis];
+  if (std::isfinite(min)) os << " >= " << min;
+  if (std::isfinite(min) && std::isfinite(max)) os << " and";
+  if (std::isfinite(max)) os << " <= " << max;
+  return os.str();
+}
+
+std::string Scenario::describe(const ContactSpec& c) const {
+  return robot->spots()[c.spot].name + "@" + scene->surfaces()[c.surface].name +
+         (c.supporting ? " (supporting)" : " (geometric only)");
+}
+
+Scenario Scenario::load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FormatError(path, "", "cannot open the file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return loadText(ss.str(), path, fs::path(path).parent_path().string());
+}
+
+Scenario Scenario::loadText(const std::string& text, const std::string& origin, const std::string& base_dir) {
+  YamlField root = YamlField::loadText(text, origin);
+  root.requireFormat("acyclic.scenario/1");
+  root.allowOnly({"format", "name", "robot", "scene", "seed", "start", "allowed_spots", "allowed_surfaces",
+                  "goal", "key_postures"});
+  Scenario sc;
+  sc.path = origin;
+  sc.name = root.has("name") ? root["name"].string() : fs::path(origin).stem().string();
+  auto resolve = [&](const YamlField& f) { return (fs::path(base_dir) / f.string()).lexically_normal().string(); };
+  sc.robot = RobotModel::load(resolve(root["robot"]));
+  sc.scene = Scene::load(resolve(root["scene"]));
+  if (root.has("seed")) {
+    int s = root["seed"].integer();
+    if (s < 0) root["seed"].fail("a non-negative integer");
+    sc.seed = static_cast<std::uint64_t>(s);
+  }
+
+  auto spotOf = [&](const YamlField& f) {
+    int i = sc.robot->spotIndex(f.string());
+    if (i < 0) {
+      std::string names;
+      for (const auto& s : sc.robot->spots()) names += (names.empty() ? "" : ", ") + s.name;
+      f.fail("a contact spot of the robot (" + names + ")");
+    }
+    return i;
+  };
+  auto surfaceOf = [&](const YamlField& f) {
+    int i = sc.scene->surfaceIndex(f.string());
+    if (i < 0) {
+      std::string names;
+      for (const auto& s : sc.scene->surfaces()) names += (names.empty() ? "" : ", ") + s.name;
+      f.fail("a surface of the scene (" + names + ")");
+    }
+    return i;
+  };
+
+  YamlField start = root["start"];
+  start.allowOnly({"configuration", "contacts"});
+  sc.start = sc.robot->readConfiguration(start["configuration"]);
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(sc.start);
+  YamlField contacts = start["contacts"];
+  std::set<int> used_spots;
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    YamlField c = contacts.at(i);
+    c.allowOnly({"spot", "surface", "supporting", "x", "y", "theta", "theta_deg"});
+    ContactSpec cs;
+    cs.spot = spotOf(c["spot"]);
+    if (!used_spots.insert(cs.spot).second) c["spot"].fail("a spot not already in contact");
+    cs.surface = surfaceOf(c["surface"]);
+    cs.supporting = c.has("supporting") ? c["supporting"].boolean() : true;
+    // Placement: given, or taken from the start configuration.
+    cs.placement = projectOnSurface(sc.scene->surfaces()[cs.surface], kin.spotPose(cs.spot));
+    if (c.has("x")) cs.placement.x = c["x"].number();
+    if (c.has("y")) cs.placement.y = c["y"].number();
+    if (c.has("theta") && c.has("theta_deg")) c.fail("at most one of theta and theta_deg");
+    if (c.has("theta")) cs.placement.theta = c["theta"].number();
+    if (c.has("theta_deg")) cs.placement.theta = c["theta_deg"].number() * M_PI / 180;
+    sc.start_stance.push_back(cs);
+  }
+  if (sc.start_stance.empty()) contacts.fail("at least one contact");
+
+  if (root.has("allowed_spots")) {
+    YamlField a = root["allowed_spots"];
+    for (std::size_t i = 0; i < a.size(); ++i) sc.allowed_spots.push_back(spotOf(a.at(i)));
+  } else {
+    for (std::size_t i = 0; i < sc.robot->spots().size(); ++i) sc.allowed_spots.push_back(static_cast<int>(i));
+  }
+  if (root.has("allowed_surfaces")) {
+    YamlField a = root["allowed_surfaces"];
+    for (std::size_t i = 0; i < a.size(); ++i) sc.allowed_surfaces.push_back(surfaceOf(a.at(i)));
+  } else {
+    for (std::size_t i = 0; i < sc.scene->surfaces().size(); ++i)
+      sc.allowed_surfaces.push_back(static_cast<int>(i));
+  }
+
+  YamlField goal = root["goal"];
+  goal.allowOnly({"link", "axis", "min", "max"});
+  sc.goal.link = sc.robot->linkIndex(goal["link"].string());
+  if (sc.goal.link < 0) goal["link"].fail("a link of the robot");
+  const std::string axis = goal["axis"].string();
+  if (axis != "x" && axis != "y" && axis != "z") goal["axis"].fail("one of x, y, z");
+  sc.goal.axis = axis[0] - 'x';
+  if (!goal.has("min") && !goal.has("max")) goal.fail("a map with min, max or both");
+  if (goal.has("min")) sc.goal.min = goal["min"].number();
+  if (goal.has("max")) sc.goal.max = goal["max"].number();
+  if (sc.goal.min > sc.goal.max) goal.fail("min <= max");
+
+  if (root.has("key_postures")) {
+    YamlField kp = root["key_postures"];
+    for (std::size_t i = 0; i < kp.size(); ++i) sc.key_postures.push_back(sc.robot->readConfiguration(kp.at(i)));
+    if (sc.key_postures.size() == 1) kp.fail("at least two key postures (a start and an end)");
+  }
+  return sc;
+}
+
+}  // namespace acyclic

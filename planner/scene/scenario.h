@@ -1,0 +1,57 @@
+#pragma once
+// A planning problem: robot, scene, start configuration and stance, allowed
+// contacts, goal condition, optional hand-written key postures, seed.
+// Format acyclic.scenario/1, documented in README.md.
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "planner/model/robot_model.h"
+#include "planner/scene/scene.h"
+
+namespace acyclic {
+
+class Kinematics;
+
+struct ContactSpec {
+  int spot = -1;
+  int surface = -1;
+  bool supporting = true;
+  SurfacePlacement placement;
+};
+
+// The goal: a coordinate of a link's origin within bounds (paper, 3.1: "a
+// coordinate the waist must exceed").
+struct GoalCondition {
+  int link = 0;
+  int axis = 0;  // 0 x, 1 y, 2 z
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool satisfied(const Kinematics& k) const;
+  std::string describe(const RobotModel& m) const;
+};
+
+struct Scenario {
+  std::string path;
+  std::string name;
+  std::shared_ptr<const RobotModel> robot;
+  std::shared_ptr<const Scene> scene;
+  Configuration start;
+  std::vector<ContactSpec> start_stance;
+  std::vector<int> allowed_spots;
+  std::vector<int> allowed_surfaces;
+  GoalCondition goal;
+  std::vector<Configuration> key_postures;
+  std::uint64_t seed = 1;
+
+  // Loads a scenario file; robot and scene paths resolve against its folder.
+  static Scenario load(const std::string& path);
+  // The same from text (e.g. a request message); paths resolve against base_dir.
+  static Scenario loadText(const std::string& text, const std::string& origin, const std::string& base_dir);
+
+  std::string describe(const ContactSpec& c) const;  // "r_sole@floor (supporting)"
+};
+
+}  // namespace acyclic
