@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
 
 namespace acyclic {
@@ -39,7 +40,54 @@ double boundingRadius(const CollisionShape& s) {
   return 0;
 }
 
+fcl::DistanceRequestd makeDistanceRequest() {
+  fcl::DistanceRequestd req(true);  // nearest points; unsigned (see fclDistance)
+  req.gjk_solver_type = fcl::GST_LIBCCD;
+  req.distance_tolerance = 1e-9;    // GJK stops at 1e-6 by default: too coarse for gradients
+  return req;
+}
+
+// Signed distance with world witness points. Separated shapes: GJK distance.
+// Penetrating shapes: the depth and normal of fcl::collide's contact. FCL's
+// own signed distance (its EPA) is not used: Debian's FCL 0.7 is built with
+// assertions and aborts inside that EPA on some penetrating pairs.
+double fclDistance(const fcl::CollisionGeometryd* ga, const Eigen::Isometry3d& Ta, const fcl::CollisionGeometryd* gb,
+                   const Eigen::Isometry3d& Tb, Eigen::Vector3d* pa, Eigen::Vector3d* pb) {
+  static const fcl::DistanceRequestd dreq = makeDistanceRequest();
+  const fcl::Transform3d Xa(Ta.matrix()), Xb(Tb.matrix());
+  fcl::DistanceResultd dres;
+  fcl::distance(ga, Xa, gb, Xb, dreq, dres);
+  if (dres.min_distance > 0) {
+    if (pa) *pa = dres.nearest_points[0];
+    if (pb) *pb = dres.nearest_points[1];
+    return dres.min_distance;
+  }
+  fcl::CollisionRequestd creq(1, true);  // one contact, with depth and normal
+  creq.gjk_solver_type = fcl::GST_LIBCCD;
+  fcl::CollisionResultd cres;
+  fcl::collide(ga, Xa, gb, Xb, creq, cres);
+  if (!cres.isCollision() || cres.numContacts() == 0) {
+    // Touching within GJK's tolerance: distance zero at the shapes' closest point.
+    if (pa) *pa = dres.nearest_points[0];
+    if (pb) *pb = dres.nearest_points[0];
+    return 0.0;
+  }
+  const fcl::Contactd& c = cres.getContact(0);
+  // normal points from a to b; a's deepest point lies depth/2 along it from pos
+  const Eigen::Vector3d n = c.normal.normalized();
+  if (pa) *pa = c.pos + 0.5 * c.penetration_depth * n;
+  if (pb) *pb = c.pos - 0.5 * c.penetration_depth * n;
+  return -c.penetration_depth;
+}
+
 }  // namespace
+
+double shapeDistance(const CollisionShape& a, const Eigen::Isometry3d& Ta, const CollisionShape& b,
+                     const Eigen::Isometry3d& Tb, Eigen::Vector3d* point_a, Eigen::Vector3d* point_b) {
+  auto ga = makeGeometry(a);
+  auto gb = makeGeometry(b);
+  return fclDistance(ga.get(), Ta, gb.get(), Tb, point_a, point_b);
+}
 
 struct CollisionModel::Geometry {
   // robot[link][shape], obstacles[i]
@@ -119,8 +167,6 @@ std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const
   for (const auto& l : links)
     if (!l.shapes.empty()) link_pose[l.index] = kin.linkPose(l.index);
 
-  fcl::DistanceRequestd req(true, true);  // nearest points, signed distance
-  req.gjk_solver_type = fcl::GST_LIBCCD;
   std::vector<PairDistance> out;
   out.reserve(pairs_.size());
 
@@ -148,13 +194,9 @@ std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const
     }
     if (lower_bound > opt.cutoff) continue;
 
-    fcl::DistanceResultd res;
-    fcl::distance(ga, fcl::Transform3d(Ta.matrix()), gb, fcl::Transform3d(Tb.matrix()), req, res);
     PairDistance d;
     d.pair = i;
-    d.distance = res.min_distance;
-    d.point_a = res.nearest_points[0];
-    d.point_b = res.nearest_points[1];
+    d.distance = fclDistance(ga, Ta, gb, Tb, &d.point_a, &d.point_b);
     if (opt.gradients) {
       // d = n . (pb - pa) with n = (pb - pa) / d for either sign of d, so
       // grad d = n^T (J_b(pb) - J_a(pa)). At contact (d ~ 0) the witness

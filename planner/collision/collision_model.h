@@ -35,6 +35,12 @@ struct DistanceOptions {
   double cutoff = std::numeric_limits<double>::infinity();
 };
 
+// Signed distance between two primitives at world poses, with world witness
+// points (FCL; the routine every pair of CollisionModel goes through).
+double shapeDistance(const CollisionShape& a, const Eigen::Isometry3d& Ta, const CollisionShape& b,
+                     const Eigen::Isometry3d& Tb, Eigen::Vector3d* point_a = nullptr,
+                     Eigen::Vector3d* point_b = nullptr);
+
 class CollisionModel {
  public:
   CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene);
