@@ -238,3 +238,17 @@ TEST(LcmTypes, FingerprintsDifferBetweenTypes) {
                          acyclic::hrp2_bridge_status_t::getHash(), acyclic::hrp2_estop_t::getHash()};
   EXPECT_EQ(f.size(), 11u);
 }
+
+TEST(LcmTypes, JavaJarHoldsEveryTypeForLcmSpy) {
+  const std::string jar = std::string(ACYCLIC_BINARY_DIR) + "/acyclic_lcmtypes.jar";
+  FILE* p = popen(("jar tf " + jar + " 2>&1").c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string listing;
+  char buf[4096];
+  while (std::size_t n = fread(buf, 1, sizeof buf, p)) listing.append(buf, n);
+  pclose(p);
+  for (const char* t : {"request_t", "cancel_t", "guide_t", "plan_t", "stance_t", "contact_t", "configuration_t",
+                        "progress_t", "process_status_t", "trajectory_t", "trajectory_phase_t", "hrp2_command_t",
+                        "hrp2_state_t", "hrp2_bridge_status_t", "hrp2_estop_t"})
+    EXPECT_NE(listing.find(std::string("acyclic/") + t + ".class"), std::string::npos) << t << "\n" << listing;
+}
