@@ -218,3 +218,35 @@ TEST(Hrp2Model, KinematicsOnTwoThreadsAgreeWithOneThread) {
     EXPECT_EQ(ref[i], b[i]);
   }
 }
+
+TEST(Hrp2Model, ChainJacobiansMatchSimbody) {
+  // The posture generator's fast Jacobians (from cached joint axes) against
+  // Simbody's, and the gradient helpers against finite differences.
+  auto m = hrp2();
+  Kinematics k(m), probe(m);
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Configuration q = randomConfiguration(*m, rng);
+    k.setConfiguration(q);
+    for (const auto& l : m->links()) {
+      const Eigen::Vector3d local(0.02, -0.03, -0.05);
+      const Eigen::Vector3d world = k.linkPose(l.index) * local;
+      EXPECT_LT(test::relativeError(k.chainPointJacobian(l.index, world), k.pointJacobian(l.index, local)), 1e-12)
+          << l.name;
+      const Eigen::Vector3d v(0.3, -1.2, 0.7);
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(q.tangentSize());
+      k.addPointGradient(l.index, world, v, g);
+      EXPECT_LT(test::relativeError(g.transpose(), v.transpose() * k.pointJacobian(l.index, local)), 1e-12);
+    }
+    // d(u . w)/dq for the z axis of a contact spot, against finite differences.
+    const int spot = m->spotIndex("l_palm");
+    const Eigen::Vector3d w(0.2, 0.5, -0.8);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(q.tangentSize());
+    k.addAxisGradient(m->spots()[spot].link, k.spotPose(spot).linear().col(2), w, g);
+    const Eigen::MatrixXd num = numericJacobian(q, 1, [&](const Configuration& c) {
+      probe.setConfiguration(c);
+      return Eigen::VectorXd::Constant(1, probe.spotPose(spot).linear().col(2).dot(w));
+    });
+    EXPECT_LT(test::relativeError(g.transpose(), num), 1e-6);
+  }
+}

@@ -163,9 +163,7 @@ std::string CollisionModel::describe(int i) const {
 
 std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const DistanceOptions& opt) const {
   const auto& links = robot_->links();
-  std::vector<Eigen::Isometry3d> link_pose(links.size());
-  for (const auto& l : links)
-    if (!l.shapes.empty()) link_pose[l.index] = kin.linkPose(l.index);
+  auto link_pose = [&kin](int l) -> const Eigen::Isometry3d& { return kin.linkPose(l); };
 
   std::vector<PairDistance> out;
   out.reserve(pairs_.size());
@@ -173,7 +171,7 @@ std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const
   for (int i = 0; i < static_cast<int>(pairs_.size()); ++i) {
     const CollisionPair& p = pairs_[i];
     const CollisionShape& sa = links[p.link_a].shapes[p.shape_a];
-    const Eigen::Isometry3d Ta = link_pose[p.link_a] * sa.pose;
+    const Eigen::Isometry3d Ta = link_pose(p.link_a) * sa.pose;
     const fcl::CollisionGeometryd* ga = geom_->robot[p.link_a][p.shape_a].get();
     const double ra = geom_->robot_radius[p.link_a][p.shape_a];
     const fcl::CollisionGeometryd* gb;
@@ -188,7 +186,7 @@ std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const
       lower_bound = (c - q).norm() - ra;
     } else {
       const CollisionShape& sb = links[p.link_b].shapes[p.shape_b];
-      Tb = link_pose[p.link_b] * sb.pose;
+      Tb = link_pose(p.link_b) * sb.pose;
       gb = geom_->robot[p.link_b][p.shape_b].get();
       lower_bound = (Ta.translation() - Tb.translation()).norm() - ra - geom_->robot_radius[p.link_b][p.shape_b];
     }
@@ -206,12 +204,9 @@ std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const
         n = (d.point_b - d.point_a) / d.distance;
       else
         n = (Tb.translation() - Ta.translation()).normalized();
-      const Eigen::Vector3d pa_local = link_pose[p.link_a].inverse() * d.point_a;
-      d.gradient = -(n.transpose() * kin.pointJacobian(p.link_a, pa_local)).transpose();
-      if (p.kind == CollisionPair::Kind::Self) {
-        const Eigen::Vector3d pb_local = link_pose[p.link_b].inverse() * d.point_b;
-        d.gradient += (n.transpose() * kin.pointJacobian(p.link_b, pb_local)).transpose();
-      }
+      d.gradient = Eigen::VectorXd::Zero(robot_->tangentSize());
+      kin.addPointGradient(p.link_a, d.point_a, -n, d.gradient);
+      if (p.kind == CollisionPair::Kind::Self) kin.addPointGradient(p.link_b, d.point_b, n, d.gradient);
     }
     out.push_back(std::move(d));
   }

@@ -36,16 +36,48 @@ void Kinematics::setConfiguration(const Configuration& q) {
   SimTK::Vector& Q = state_->s.updQ();
   for (int j = 0; j < model_->numJoints(); ++j) Q[S.q_of_joint[j]] = q.joints[j];
   S.system.realize(state_->s, SimTK::Stage::Position);
+  const int nl = model_->numLinks();
+  link_pose_.resize(nl);
+  for (int l = 0; l < nl; ++l) {
+    const SimTK::Transform& X = S.matter.getMobilizedBody(S.link_mobod[l]).getBodyTransform(state_->s);
+    Eigen::Isometry3d& T = link_pose_[l];
+    T.setIdentity();
+    const SimTK::Mat33& R = X.R().asMat33();
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) T.linear()(i, k) = R(i, k);
+    T.translation() = toEigen(X.p());
+  }
+  // A joint's frame is its child link's frame: its axis there is unchanged by its own rotation.
+  joint_axis_.resize(model_->numJoints());
+  joint_origin_.resize(model_->numJoints());
+  for (const auto& j : model_->joints()) {
+    joint_axis_[j.index] = link_pose_[j.child_link].linear() * j.axis;
+    joint_origin_[j.index] = link_pose_[j.child_link].translation();
+  }
 }
 
-Eigen::Isometry3d Kinematics::linkPose(int link) const {
-  const auto& S = model_->impl();
-  const SimTK::Transform& X = S.matter.getMobilizedBody(S.link_mobod.at(link)).getBodyTransform(state_->s);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  for (int i = 0; i < 3; ++i)
-    for (int k = 0; k < 3; ++k) T.linear()(i, k) = X.R().asMat33()(i, k);
-  T.translation() = toEigen(X.p());
-  return T;
+Eigen::MatrixXd Kinematics::chainPointJacobian(int link, const Eigen::Vector3d& p) const {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, model_->tangentSize());
+  const Eigen::Vector3d r = p - link_pose_[0].translation();
+  J.block<3, 3>(0, 0).setIdentity();
+  J.block<3, 3>(0, 3) << 0, r.z(), -r.y(), -r.z(), 0, r.x(), r.y(), -r.x(), 0;  // -[r]x
+  for (int j : model_->ancestorJoints(link)) J.col(6 + j) = joint_axis_[j].cross(p - joint_origin_[j]);
+  return J;
+}
+
+void Kinematics::addPointGradient(int link, const Eigen::Vector3d& p, const Eigen::Vector3d& v,
+                                  Eigen::Ref<Eigen::VectorXd> grad) const {
+  grad.segment<3>(0) += v;
+  grad.segment<3>(3) += (p - link_pose_[0].translation()).cross(v);
+  for (int j : model_->ancestorJoints(link)) grad[6 + j] += v.dot(joint_axis_[j].cross(p - joint_origin_[j]));
+}
+
+void Kinematics::addAxisGradient(int link, const Eigen::Vector3d& u, const Eigen::Vector3d& w,
+                                 Eigen::Ref<Eigen::VectorXd> grad) const {
+  // A rotation by omega moves u by omega x u: d(u . w) = omega . (u x w).
+  const Eigen::Vector3d uxw = u.cross(w);
+  grad.segment<3>(3) += uxw;
+  for (int j : model_->ancestorJoints(link)) grad[6 + j] += joint_axis_[j].dot(uxw);
 }
 
 Eigen::Isometry3d Kinematics::spotPose(int spot) const {

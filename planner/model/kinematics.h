@@ -28,12 +28,26 @@ class Kinematics {
   void setConfiguration(const Configuration& q);
   const Configuration& configuration() const { return q_; }
 
-  Eigen::Isometry3d linkPose(int link) const;
+  // Cached at setConfiguration (no Simbody call).
+  const Eigen::Isometry3d& linkPose(int link) const { return link_pose_[link]; }
+  const Eigen::Vector3d& jointAxis(int joint) const { return joint_axis_[joint]; }      // world
+  const Eigen::Vector3d& jointOrigin(int joint) const { return joint_origin_[joint]; }  // world
   Eigen::Isometry3d spotPose(int spot) const;
   // Jacobian (3 x tangent) of a point fixed on a link, given in link coordinates.
   Eigen::MatrixXd pointJacobian(int link, const Eigen::Vector3d& point_in_link) const;
   // Jacobian (6 x tangent) of a frame fixed on a link, origin given in link coordinates.
   Eigen::MatrixXd frameJacobian(int link, const Eigen::Vector3d& origin_in_link) const;
+  // The same Jacobians from the cached joint axes (the hot path of the
+  // posture generator; tested against Simbody's): a point moving with a link,
+  // given in world coordinates.
+  Eigen::MatrixXd chainPointJacobian(int link, const Eigen::Vector3d& world_point) const;
+  // grad += J(point)^T v: the gradient of v . point, without forming J.
+  void addPointGradient(int link, const Eigen::Vector3d& world_point, const Eigen::Vector3d& v,
+                        Eigen::Ref<Eigen::VectorXd> grad) const;
+  // grad += d(u . w)/dq for a unit vector u fixed on a link and a constant w.
+  void addAxisGradient(int link, const Eigen::Vector3d& u, const Eigen::Vector3d& w,
+                       Eigen::Ref<Eigen::VectorXd> grad) const;
+
   Eigen::Vector3d centerOfMass() const;
   Eigen::MatrixXd centerOfMassJacobian() const;  // 3 x tangent
   // Generalized forces that hold the robot still against gravity, g(q): the
@@ -46,6 +60,8 @@ class Kinematics {
   std::shared_ptr<const RobotModel> model_;
   std::unique_ptr<State> state_;
   Configuration q_;
+  std::vector<Eigen::Isometry3d> link_pose_;
+  std::vector<Eigen::Vector3d> joint_axis_, joint_origin_;
 };
 
 }  // namespace acyclic

@@ -142,6 +142,20 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
     if (!seen.count(name))
       throw FormatError(yaml_path, "controller_order", "every joint of the URDF; missing " + name);
 
+  // Tree structure: which joints move which links.
+  m->ancestors_.assign(m->links_.size(), {});
+  for (const auto& l : m->links_) {
+    for (int j = l.parent_joint; j >= 0; j = m->links_[m->joints_[j].parent_link].parent_joint)
+      m->ancestors_[l.index].insert(m->ancestors_[l.index].begin(), j);
+  }
+  m->moves_.assign(m->joints_.size(), std::vector<bool>(m->links_.size(), false));
+  m->subtree_mass_.assign(m->joints_.size(), 0.0);
+  for (const auto& l : m->links_)
+    for (int j : m->ancestors_[l.index]) {
+      m->moves_[j][l.index] = true;
+      m->subtree_mass_[j] += l.mass;
+    }
+
   // Simbody: a free-flying base and one pin per joint.
   Impl& S = *m->impl_;
   auto massProps = [](const LinkInfo& l) {

@@ -79,6 +79,11 @@ class RobotModel {
   const std::vector<std::pair<int, int>>& selfCollisionPairs() const { return self_pairs_; }
   const std::map<std::string, Configuration>& postures() const { return postures_; }
 
+  // Static tree structure (controller joint indices):
+  const std::vector<int>& ancestorJoints(int link) const { return ancestors_[link]; }  // base to link
+  bool jointMovesLink(int joint, int link) const { return moves_[joint][link]; }
+  double subtreeMass(int joint) const { return subtree_mass_[joint]; }  // links moved by the joint
+
   int jointIndex(const std::string& name) const;  // -1 if unknown
   int linkIndex(const std::string& name) const;
   int spotIndex(const std::string& name) const;
@@ -109,6 +114,9 @@ class RobotModel {
   std::vector<ContactSpot> spots_;
   std::vector<std::pair<int, int>> self_pairs_;
   std::map<std::string, Configuration> postures_;
+  std::vector<std::vector<int>> ancestors_;
+  std::vector<std::vector<bool>> moves_;
+  std::vector<double> subtree_mass_;
   std::unique_ptr<Impl> impl_;
 };
 
