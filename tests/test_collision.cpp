@@ -259,5 +259,7 @@ TEST_F(ChairCollision, CutoffKeepsEveryCloserPair) {
   std::set<int> kept;
   for (const auto& d : near) kept.insert(d.pair);
   for (const auto& d : all)
-    if (d.distance <= 0.1) EXPECT_TRUE(kept.count(d.pair)) << cm.describe(d.pair);
+    if (d.distance <= 0.1) {
+      EXPECT_TRUE(kept.count(d.pair)) << cm.describe(d.pair);
+    }
 }

@@ -161,54 +161,64 @@ std::string CollisionModel::describe(int i) const {
   return a + " ~ " + lb.name + "/" + lb.shapes[p.shape_b].name;
 }
 
-std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const DistanceOptions& opt) const {
+double CollisionModel::lowerBound(const Kinematics& kin, int i) const {
+  const CollisionPair& p = pairs_[i];
   const auto& links = robot_->links();
-  auto link_pose = [&kin](int l) -> const Eigen::Isometry3d& { return kin.linkPose(l); };
+  const Eigen::Vector3d ca = kin.linkPose(p.link_a) * links[p.link_a].shapes[p.shape_a].pose.translation();
+  const double ra = geom_->robot_radius[p.link_a][p.shape_a];
+  if (p.kind == CollisionPair::Kind::RobotEnvironment) {
+    const fcl::AABBd& box = geom_->obstacle_aabb[p.obstacle];
+    return (ca - ca.cwiseMax(box.min_).cwiseMin(box.max_)).norm() - ra;
+  }
+  const Eigen::Vector3d cb = kin.linkPose(p.link_b) * links[p.link_b].shapes[p.shape_b].pose.translation();
+  return (ca - cb).norm() - ra - geom_->robot_radius[p.link_b][p.shape_b];
+}
 
+std::vector<int> CollisionModel::pairsWithin(const Kinematics& kin, double cutoff) const {
+  std::vector<int> out;
+  for (int i = 0; i < static_cast<int>(pairs_.size()); ++i)
+    if (lowerBound(kin, i) <= cutoff) out.push_back(i);
+  return out;
+}
+
+PairDistance CollisionModel::pairDistance(const Kinematics& kin, int i, bool gradient) const {
+  const CollisionPair& p = pairs_[i];
+  const auto& links = robot_->links();
+  const Eigen::Isometry3d Ta = kin.linkPose(p.link_a) * links[p.link_a].shapes[p.shape_a].pose;
+  Eigen::Isometry3d Tb;
+  const fcl::CollisionGeometryd* gb;
+  if (p.kind == CollisionPair::Kind::RobotEnvironment) {
+    gb = geom_->obstacles[p.obstacle].get();
+    Tb = scene_->obstacles()[p.obstacle].shape.pose;
+  } else {
+    gb = geom_->robot[p.link_b][p.shape_b].get();
+    Tb = kin.linkPose(p.link_b) * links[p.link_b].shapes[p.shape_b].pose;
+  }
+  PairDistance d;
+  d.pair = i;
+  d.distance = fclDistance(geom_->robot[p.link_a][p.shape_a].get(), Ta, gb, Tb, &d.point_a, &d.point_b);
+  if (gradient) {
+    // d = n . (pb - pa) with n = (pb - pa) / d for either sign of d, so
+    // grad d = n^T (J_b(pb) - J_a(pa)). At contact (d ~ 0) the witness
+    // points coincide; the line between the shapes' centres stands in for n.
+    Eigen::Vector3d n;
+    if (std::abs(d.distance) > 1e-9 && (d.point_b - d.point_a).norm() > 1e-9)
+      n = (d.point_b - d.point_a) / d.distance;
+    else
+      n = (Tb.translation() - Ta.translation()).normalized();
+    d.gradient = Eigen::VectorXd::Zero(robot_->tangentSize());
+    kin.addPointGradient(p.link_a, d.point_a, -n, d.gradient);
+    if (p.kind == CollisionPair::Kind::Self) kin.addPointGradient(p.link_b, d.point_b, n, d.gradient);
+  }
+  return d;
+}
+
+std::vector<PairDistance> CollisionModel::distances(const Kinematics& kin, const DistanceOptions& opt) const {
   std::vector<PairDistance> out;
   out.reserve(pairs_.size());
-
   for (int i = 0; i < static_cast<int>(pairs_.size()); ++i) {
-    const CollisionPair& p = pairs_[i];
-    const CollisionShape& sa = links[p.link_a].shapes[p.shape_a];
-    const Eigen::Isometry3d Ta = link_pose(p.link_a) * sa.pose;
-    const fcl::CollisionGeometryd* ga = geom_->robot[p.link_a][p.shape_a].get();
-    const double ra = geom_->robot_radius[p.link_a][p.shape_a];
-    const fcl::CollisionGeometryd* gb;
-    Eigen::Isometry3d Tb;
-    double lower_bound;
-    if (p.kind == CollisionPair::Kind::RobotEnvironment) {
-      gb = geom_->obstacles[p.obstacle].get();
-      Tb = scene_->obstacles()[p.obstacle].shape.pose;
-      const fcl::AABBd& box = geom_->obstacle_aabb[p.obstacle];
-      const Eigen::Vector3d c = Ta.translation();
-      const Eigen::Vector3d q = c.cwiseMax(box.min_).cwiseMin(box.max_);
-      lower_bound = (c - q).norm() - ra;
-    } else {
-      const CollisionShape& sb = links[p.link_b].shapes[p.shape_b];
-      Tb = link_pose(p.link_b) * sb.pose;
-      gb = geom_->robot[p.link_b][p.shape_b].get();
-      lower_bound = (Ta.translation() - Tb.translation()).norm() - ra - geom_->robot_radius[p.link_b][p.shape_b];
-    }
-    if (lower_bound > opt.cutoff) continue;
-
-    PairDistance d;
-    d.pair = i;
-    d.distance = fclDistance(ga, Ta, gb, Tb, &d.point_a, &d.point_b);
-    if (opt.gradients) {
-      // d = n . (pb - pa) with n = (pb - pa) / d for either sign of d, so
-      // grad d = n^T (J_b(pb) - J_a(pa)). At contact (d ~ 0) the witness
-      // points coincide; the line between the shapes' centres stands in for n.
-      Eigen::Vector3d n;
-      if (std::abs(d.distance) > 1e-9 && (d.point_b - d.point_a).norm() > 1e-9)
-        n = (d.point_b - d.point_a) / d.distance;
-      else
-        n = (Tb.translation() - Ta.translation()).normalized();
-      d.gradient = Eigen::VectorXd::Zero(robot_->tangentSize());
-      kin.addPointGradient(p.link_a, d.point_a, -n, d.gradient);
-      if (p.kind == CollisionPair::Kind::Self) kin.addPointGradient(p.link_b, d.point_b, n, d.gradient);
-    }
-    out.push_back(std::move(d));
+    if (std::isfinite(opt.cutoff) && lowerBound(kin, i) > opt.cutoff) continue;
+    out.push_back(pairDistance(kin, i, opt.gradients));
   }
   return out;
 }

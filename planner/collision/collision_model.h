@@ -54,6 +54,10 @@ class CollisionModel {
   // Distances of every pair (within the cutoff) at the kinematics' configuration.
   // Thread-safe: the model is read-only; use one Kinematics per thread.
   std::vector<PairDistance> distances(const Kinematics& kin, const DistanceOptions& opt = {}) const;
+  // One pair's distance (and gradient if asked).
+  PairDistance pairDistance(const Kinematics& kin, int pair, bool gradient) const;
+  // The pairs that bounding volumes cannot rule out within `cutoff`.
+  std::vector<int> pairsWithin(const Kinematics& kin, double cutoff) const;
 
  private:
   struct Geometry;
@@ -61,6 +65,7 @@ class CollisionModel {
   std::shared_ptr<const Scene> scene_;
   std::vector<CollisionPair> pairs_;
   int n_env_ = 0;
+  double lowerBound(const Kinematics& kin, int pair) const;
   std::unique_ptr<Geometry> geom_;
 };
 

@@ -1,0 +1,32 @@
+#pragma once
+// Costs of the posture generator, behind one interface (DESIGN.md section 6):
+// distance to a reference posture now, the guide potential f_T later.
+#include <Eigen/Core>
+
+#include "planner/model/kinematics.h"
+
+namespace acyclic {
+
+class PostureCost {
+ public:
+  virtual ~PostureCost() = default;
+  // The cost at the kinematics' configuration; adds its gradient (tangent
+  // space, configuration.h) to grad.
+  virtual double evaluate(const Kinematics& kin, Eigen::Ref<Eigen::VectorXd> grad) const = 0;
+};
+
+// w_joint |q - r|^2 + w_position |p - p_r|^2 + w_rotation |R - R_r|_F^2.
+class ReferencePostureCost : public PostureCost {
+ public:
+  explicit ReferencePostureCost(Configuration reference, double w_joint = 1.0, double w_position = 10.0,
+                                double w_rotation = 1.0);
+  double evaluate(const Kinematics& kin, Eigen::Ref<Eigen::VectorXd> grad) const override;
+  const Configuration& reference() const { return ref_; }
+
+ private:
+  Configuration ref_;
+  Eigen::Matrix3d ref_rotation_;
+  double wj_, wp_, wr_;
+};
+
+}  // namespace acyclic

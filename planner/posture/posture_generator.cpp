@@ -1,0 +1,215 @@
+#include "planner/posture/posture_generator.h"
+
+#include <chrono>
+#include <set>
+
+#include <IpIpoptApplication.hpp>
+#include <IpTNLP.hpp>
+
+namespace acyclic {
+
+const char* toString(PostureResult::Status s) {
+  switch (s) {
+    case PostureResult::Status::Success: return "success";
+    case PostureResult::Status::Infeasible: return "infeasible";
+    case PostureResult::Status::IterationLimit: return "iteration limit";
+    case PostureResult::Status::TimeLimit: return "time limit";
+    case PostureResult::Status::BadInput: return "bad input";
+  }
+  return "?";
+}
+
+namespace {
+
+// Ipopt's view of a PostureProblem.
+class PostureTNLP : public Ipopt::TNLP {
+ public:
+  explicit PostureTNLP(PostureProblem& p, const Eigen::VectorXd& x0) : p_(p), x0_(x0) {}
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    n = p_.numVariables();
+    m = p_.numConstraints();
+    nnz_jac = static_cast<Ipopt::Index>(p_.jacobianStructure().size());
+    nnz_h = 0;  // limited-memory quasi-Newton
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m, Ipopt::Number* gl,
+                       Ipopt::Number* gu) override {
+    Eigen::VectorXd a, b, c, d;
+    p_.bounds(a, b, c, d);
+    std::copy(a.data(), a.data() + n, xl);
+    std::copy(b.data(), b.data() + n, xu);
+    std::copy(c.data(), c.data() + m, gl);
+    std::copy(d.data(), d.data() + m, gu);
+    return true;
+  }
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool, Ipopt::Number*, Ipopt::Number*,
+                          Ipopt::Index, bool, Ipopt::Number*) override {
+    if (init_x) std::copy(x0_.data(), x0_.data() + n, x);
+    return true;
+  }
+  bool eval_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    f = p_.cost(map(n, x));
+    return std::isfinite(f);
+  }
+  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
+    const Eigen::VectorXd gr = p_.costGradient(map(n, x));
+    std::copy(gr.data(), gr.data() + n, g);
+    return gr.allFinite();
+  }
+  bool eval_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index m, Ipopt::Number* g) override {
+    const Eigen::VectorXd v = p_.constraints(map(n, x));
+    std::copy(v.data(), v.data() + m, g);
+    return v.allFinite();
+  }
+  bool eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Index, Ipopt::Index* rows,
+                  Ipopt::Index* cols, Ipopt::Number* values) override {
+    if (!values) {
+      const auto& s = p_.jacobianStructure();
+      for (std::size_t k = 0; k < s.size(); ++k) rows[k] = s[k].first, cols[k] = s[k].second;
+      return true;
+    }
+    p_.jacobianValues(map(n, x), values);
+    return true;
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Index, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    iterations = iter;
+    return true;
+  }
+  void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
+                         const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*,
+                         Ipopt::Number obj, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    final_status = status;
+    x_final = map(n, x);
+    final_cost = obj;
+  }
+
+  Ipopt::SolverReturn final_status = Ipopt::INTERNAL_ERROR;
+  Eigen::VectorXd x_final;
+  double final_cost = 0;
+  int iterations = 0;
+
+ private:
+  static Eigen::VectorXd map(Ipopt::Index n, const Ipopt::Number* x) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
+  PostureProblem& p_;
+  Eigen::VectorXd x0_;
+};
+
+}  // namespace
+
+struct PostureGenerator::Ipopt {
+  ::Ipopt::SmartPtr<::Ipopt::IpoptApplication> app;
+};
+
+PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                                   PostureGeneratorOptions options)
+    : robot_(std::move(robot)), scene_(std::move(scene)),
+      collision_(std::make_shared<CollisionModel>(robot_, scene_)), opt_(options),
+      ipopt_(std::make_unique<Ipopt>()) {
+  auto& app = ipopt_->app;
+  app = IpoptApplicationFactory();
+  auto o = app->Options();
+  o->SetStringValue("sb", "yes");  // no banner
+  o->SetIntegerValue("print_level", opt_.print_level);
+  o->SetStringValue("hessian_approximation", "limited-memory");
+  o->SetStringValue("mu_strategy", "adaptive");
+  o->SetNumericValue("tol", opt_.tolerance);
+  o->SetNumericValue("constr_viol_tol", opt_.tolerance);
+  // A witness posture needs feasibility, not a polished optimum: stop once
+  // feasible with an objective that has settled (L-BFGS polishes slowly).
+  o->SetNumericValue("acceptable_tol", 1e10);  // judged by the criteria below, not by dual infeasibility
+  o->SetNumericValue("acceptable_constr_viol_tol", opt_.tolerance);
+  o->SetNumericValue("acceptable_dual_inf_tol", 1e10);
+  o->SetNumericValue("acceptable_compl_inf_tol", 1e-3);
+  o->SetNumericValue("acceptable_obj_change_tol", 1e-3);
+  o->SetIntegerValue("acceptable_iter", 3);
+  o->SetIntegerValue("max_iter", opt_.max_iterations);
+  o->SetNumericValue("max_cpu_time", opt_.max_seconds);
+  if (app->Initialize() != ::Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialize");
+}
+
+PostureGenerator::~PostureGenerator() = default;
+
+PostureResult PostureGenerator::solve(const PostureRequest& request) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PostureResult res;
+  res.configuration = request.initial_guess;
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  std::unique_ptr<PostureProblem> problem;
+  try {
+    problem = std::make_unique<PostureProblem>(robot_, scene_, collision_, request, opt_.problem);
+  } catch (const std::invalid_argument& e) {
+    res.status = PostureResult::Status::BadInput;
+    res.reason = e.what();
+    res.seconds = elapsed();
+    return res;
+  }
+
+  Eigen::VectorXd x0 = problem->initialPoint();
+  for (int round = 0; round <= opt_.collision_rounds; ++round) {
+    ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0);
+    const double budget = opt_.max_seconds - elapsed();
+    if (budget <= 0) {
+      res.status = PostureResult::Status::TimeLimit;
+      res.reason = "time limit reached before the solve";
+      break;
+    }
+    ipopt_->app->Options()->SetNumericValue("max_cpu_time", budget);
+    ipopt_->app->OptimizeTNLP(nlp);
+    res.iterations += nlp->iterations;
+    const Eigen::VectorXd& x = nlp->x_final.size() ? nlp->x_final : x0;
+    res.configuration = problem->configurationAt(x);
+    res.floating = problem->floatingAt(x);
+    res.forces = problem->forcesAt(x);
+    res.cost = nlp->final_cost;
+    switch (nlp->final_status) {
+      case ::Ipopt::SUCCESS:
+      case ::Ipopt::STOP_AT_ACCEPTABLE_POINT:
+        res.status = PostureResult::Status::Success;
+        break;
+      case ::Ipopt::MAXITER_EXCEEDED:
+        res.status = PostureResult::Status::IterationLimit;
+        res.reason = "no feasible posture within " + std::to_string(opt_.max_iterations) + " iterations";
+        break;
+      case ::Ipopt::CPUTIME_EXCEEDED:
+        res.status = PostureResult::Status::TimeLimit;
+        res.reason = "no feasible posture within the time limit";
+        break;
+      case ::Ipopt::LOCAL_INFEASIBILITY:
+        res.status = PostureResult::Status::Infeasible;
+        res.reason = "the constraints are locally infeasible";
+        break;
+      default:
+        res.status = PostureResult::Status::Infeasible;
+        res.reason = "the solver stopped without a feasible posture (Ipopt status " +
+                     std::to_string(static_cast<int>(nlp->final_status)) + ")";
+        break;
+    }
+    if (!res.success()) break;
+    // Pairs left out of the problem may collide at the solution: add those
+    // near it (the problem drops a contacting body's own surface) and, if one
+    // of them collides, solve again from there.
+    Kinematics kin(robot_);
+    kin.setConfiguration(res.configuration);
+    const std::set<int> before(problem->collisionPairs().begin(), problem->collisionPairs().end());
+    problem->addCollisionPairs(collision_->pairsWithin(kin, opt_.problem.collision_cutoff));
+    bool collides = false;
+    for (int p : problem->collisionPairs())
+      if (!before.count(p) && collision_->pairDistance(kin, p, false).distance < 0) collides = true;
+    if (!collides) break;
+    if (round == opt_.collision_rounds) {
+      res.status = PostureResult::Status::Infeasible;
+      res.reason = "collisions with pairs outside the problem remain after " + std::to_string(round + 1) + " solves";
+      break;
+    }
+    x0 = x;  // warm start from the colliding solution with the new rows
+  }
+  res.seconds = elapsed();
+  return res;
+}
+
+}  // namespace acyclic

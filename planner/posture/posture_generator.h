@@ -1,0 +1,61 @@
+#pragma once
+// The posture generator (DESIGN.md section 6): one Ipopt solve per call finds
+// a configuration (and the floating contact's placement, and the contact
+// forces) that satisfies a stance's constraints at the least cost.
+// Failures return a status with a reason; exceptions are for misuse only.
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "planner/posture/posture_problem.h"
+
+namespace acyclic {
+
+struct PostureGeneratorOptions {
+  PostureOptions problem;
+  int max_iterations = 300;
+  double max_seconds = 0.5;           // CPU seconds per solve (Ipopt's max_cpu_time)
+  double tolerance = 1e-6;            // Ipopt's tol and constr_viol_tol
+  int collision_rounds = 3;           // re-solves when a pair left out of the problem collides
+  int print_level = 0;                // Ipopt's, for debugging
+};
+
+struct PostureResult {
+  enum class Status { Success, Infeasible, IterationLimit, TimeLimit, BadInput };
+  Status status = Status::BadInput;
+  std::string reason;                 // set on failure
+  Configuration configuration;        // the witness posture (the last iterate on failure)
+  SurfacePlacement floating;          // the floating contact's placement, if any
+  std::vector<PostureProblem::ContactForces> forces;  // per supporting contact
+  double cost = 0;
+  int iterations = 0;
+  double seconds = 0;                 // wall time
+  bool success() const { return status == Status::Success; }
+};
+
+const char* toString(PostureResult::Status s);
+
+class PostureGenerator {
+ public:
+  PostureGenerator(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                   PostureGeneratorOptions options = {});
+  ~PostureGenerator();
+  PostureGenerator(const PostureGenerator&) = delete;
+  PostureGenerator& operator=(const PostureGenerator&) = delete;
+
+  // Solves one request. Not re-entrant: use one generator per thread.
+  PostureResult solve(const PostureRequest& request);
+
+  const PostureGeneratorOptions& options() const { return opt_; }
+  std::shared_ptr<const CollisionModel> collisionModel() const { return collision_; }
+
+ private:
+  struct Ipopt;
+  std::shared_ptr<const RobotModel> robot_;
+  std::shared_ptr<const Scene> scene_;
+  std::shared_ptr<const CollisionModel> collision_;
+  PostureGeneratorOptions opt_;
+  std::unique_ptr<Ipopt> ipopt_;
+};
+
+}  // namespace acyclic

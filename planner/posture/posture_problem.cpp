@@ -1,0 +1,512 @@
+#include "planner/posture/posture_problem.h"
+
+#include <cmath>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+#include "planner/common/geometry.h"
+
+namespace acyclic {
+
+namespace {
+constexpr double kInf = 1e19;  // Ipopt's infinity
+const Eigen::Vector3d kGravity(0, 0, -9.81);
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return S;
+}
+
+// Outward unit normals n_e and offsets b_e of a CCW convex polygon: n_e . p <= b_e inside.
+void halfPlanes(const ConvexPolygon& poly, std::vector<Eigen::Vector2d>& n, std::vector<double>& b) {
+  const auto& v = poly.vertices();
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const Eigen::Vector2d e = v[(i + 1) % v.size()] - v[i];
+    const Eigen::Vector2d out = Eigen::Vector2d(e.y(), -e.x()).normalized();
+    n.push_back(out);
+    b.push_back(out.dot(v[i]));
+  }
+}
+}  // namespace
+
+PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                               std::shared_ptr<const CollisionModel> collision, const PostureRequest& request,
+                               const PostureOptions& options)
+    : robot_(std::move(robot)), scene_(std::move(scene)), collision_(std::move(collision)), req_(request),
+      opt_(options), kin_(robot_) {
+  if (req_.initial_guess.joints.size() != robot_->numJoints())
+    throw std::invalid_argument("initial guess has " + std::to_string(req_.initial_guess.joints.size()) +
+                                " joints, the robot " + std::to_string(robot_->numJoints()));
+  if (!req_.initial_guess.joints.allFinite() || !req_.initial_guess.base_position.allFinite() ||
+      !req_.initial_guess.base_orientation.coeffs().allFinite())
+    throw std::invalid_argument("initial guess has a non-finite value");
+  req_.initial_guess.base_orientation.normalize();
+  if (!req_.cost) req_.cost = std::make_shared<ReferencePostureCost>(req_.initial_guess);
+
+  std::set<int> spots;
+  auto checkContact = [&](int spot, int surface) {
+    if (spot < 0 || spot >= static_cast<int>(robot_->spots().size())) throw std::invalid_argument("unknown spot");
+    if (surface < 0 || surface >= static_cast<int>(scene_->surfaces().size()))
+      throw std::invalid_argument("unknown surface");
+    if (!spots.insert(spot).second)
+      throw std::invalid_argument("spot " + robot_->spots()[spot].name + " is in two contacts");
+    allowed_touch_.push_back({robot_->spots()[spot].link, scene_->surfaces()[surface].obstacle});
+  };
+  for (const auto& c : req_.contacts) {
+    checkContact(c.spot, c.surface);
+    // A fixed contact's spot polygon must lie on its surface (DESIGN.md section 9).
+    const Surface& s = scene_->surfaces()[c.surface];
+    for (const auto& v : robot_->spots()[c.spot].polygon.vertices()) {
+      const Eigen::Vector2d p = Eigen::Vector2d(c.placement.x, c.placement.y) +
+                                Eigen::Rotation2Dd(c.placement.theta) * v;
+      if (!s.polygon.contains(p, 1e-9))
+        throw std::invalid_argument("contact " + robot_->spots()[c.spot].name + "@" + s.name +
+                                    ": the spot polygon leaves the surface polygon");
+    }
+  }
+  if (req_.floating) {
+    checkContact(req_.floating->spot, req_.floating->surface);
+    if (!(req_.floating->volume.theta_min <= req_.floating->volume.theta_max))
+      throw std::invalid_argument("search volume: theta_min > theta_max");
+  }
+
+  nq_ = robot_->tangentSize();
+  int nx = nq_;
+  if (req_.floating) x_float_ = nx, nx += 3;
+  x_lambda_ = nx;
+  for (int ci = 0; ci < static_cast<int>(req_.contacts.size()); ++ci) {
+    const ContactSpec& c = req_.contacts[ci];
+    if (!c.supporting) continue;
+    const Surface& s = scene_->surfaces()[c.surface];
+    Support sup;
+    sup.contact = ci;
+    sup.link = robot_->spots()[c.spot].link;
+    const Eigen::Isometry3d T = contactFrame(s, c.placement);
+    for (const auto& v : robot_->spots()[c.spot].polygon.vertices()) sup.corners.push_back(T * Eigen::Vector3d(v.x(), v.y(), 0));
+    const Eigen::Matrix3d R = s.frame.linear();
+    for (int m = 0; m < opt_.pyramid_sides; ++m) {
+      const double phi = 2 * M_PI * m / opt_.pyramid_sides;
+      sup.generators.push_back(
+          (R.col(2) + s.friction * (std::cos(phi) * R.col(0) + std::sin(phi) * R.col(1))).normalized());
+    }
+    sup.lambda0 = nx;
+    nx += static_cast<int>(sup.corners.size() * sup.generators.size());
+    supports_.push_back(sup);
+  }
+  if (supports_.empty()) throw std::invalid_argument("no supporting contact: the robot cannot stand still");
+  n_lambda_ = nx - x_lambda_;
+  nx_ = nx;
+
+  // Collision pairs near the initial guess, except a contacting body on its surface's obstacle.
+  kin_.setConfiguration(req_.initial_guess);
+  std::vector<int> near = collision_->pairsWithin(kin_, opt_.collision_cutoff);
+  addCollisionPairs(near);
+}
+
+void PostureProblem::addCollisionPairs(const std::vector<int>& pairs) {
+  std::set<int> have(pairs_.begin(), pairs_.end());
+  for (int p : pairs) {
+    const CollisionPair& cp = collision_->pairs()[p];
+    bool allowed = false;
+    for (const auto& [link, obstacle] : allowed_touch_)
+      allowed = allowed || (cp.kind == CollisionPair::Kind::RobotEnvironment && cp.link_a == link && cp.obstacle == obstacle);
+    if (!allowed && have.insert(p).second) pairs_.push_back(p);
+  }
+  layout();
+}
+
+void PostureProblem::layout() {
+  const int n_contacts = static_cast<int>(req_.contacts.size()) + (req_.floating ? 1 : 0);
+  row_floating_ = 6 * n_contacts;
+  n_float_rows_ = 0;
+  if (req_.floating) {
+    const auto& f = *req_.floating;
+    n_float_rows_ = static_cast<int>(f.volume.polygon.size() +
+                                     robot_->spots()[f.spot].polygon.size() * scene_->surfaces()[f.surface].polygon.size());
+  }
+  row_statics_ = row_floating_ + n_float_rows_;
+  row_collision_ = row_statics_ + nq_;
+  ng_ = row_collision_ + static_cast<int>(pairs_.size());
+
+  // Sparsity by structure: which variables each row can depend on.
+  structure_.clear();
+  auto linkCols = [&](int link, std::vector<bool>& mask) {
+    for (int k = 0; k < 6; ++k) mask[k] = true;
+    for (int j : robot_->ancestorJoints(link)) mask[6 + j] = true;
+  };
+  auto emit = [&](int row, const std::vector<bool>& mask) {
+    for (int c = 0; c < nx_; ++c)
+      if (mask[c]) structure_.push_back({row, c});
+  };
+  for (int ci = 0; ci < n_contacts; ++ci) {
+    const bool floating = ci == static_cast<int>(req_.contacts.size());
+    const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
+    std::vector<bool> mask(nx_, false);
+    linkCols(robot_->spots()[spot].link, mask);
+    if (floating)
+      for (int k = 0; k < 3; ++k) mask[x_float_ + k] = true;
+    for (int r = 0; r < 6; ++r) emit(6 * ci + r, mask);
+  }
+  for (int r = 0; r < n_float_rows_; ++r) {
+    std::vector<bool> mask(nx_, false);
+    for (int k = 0; k < 3; ++k) mask[x_float_ + k] = true;
+    emit(row_floating_ + r, mask);
+  }
+  {
+    std::vector<bool> lam(nx_, false), all(nx_, false);
+    for (int c = x_lambda_; c < nx_; ++c) lam[c] = all[c] = true;
+    for (int c = 0; c < nq_; ++c) all[c] = true;
+    for (int r = 0; r < 3; ++r) emit(row_statics_ + r, lam);
+    for (int r = 3; r < 6; ++r) emit(row_statics_ + r, all);
+    for (const auto& j : robot_->joints()) {
+      std::vector<bool> mask(nx_, false);
+      for (int k = 0; k < 6; ++k) mask[k] = true;
+      for (const auto& i : robot_->joints())
+        if (robot_->jointMovesLink(i.index, j.child_link) || robot_->jointMovesLink(j.index, i.child_link))
+          mask[6 + i.index] = true;
+      for (const auto& s : supports_)
+        if (robot_->jointMovesLink(j.index, s.link))
+          for (int c = 0; c < static_cast<int>(s.corners.size() * s.generators.size()); ++c) mask[s.lambda0 + c] = true;
+      emit(row_statics_ + 6 + j.index, mask);
+    }
+  }
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const CollisionPair& p = collision_->pairs()[pairs_[k]];
+    std::vector<bool> mask(nx_, false);
+    linkCols(p.link_a, mask);
+    if (p.kind == CollisionPair::Kind::Self) linkCols(p.link_b, mask);
+    emit(row_collision_ + static_cast<int>(k), mask);
+  }
+  valid_ = false;
+}
+
+void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::VectorXd& gl, Eigen::VectorXd& gu) const {
+  xl = Eigen::VectorXd::Constant(nx_, -kInf);
+  xu = Eigen::VectorXd::Constant(nx_, kInf);
+  const Configuration& q0 = req_.initial_guess;
+  for (const auto& j : robot_->joints()) {
+    xl[6 + j.index] = j.lower - q0.joints[j.index];
+    xu[6 + j.index] = j.upper - q0.joints[j.index];
+  }
+  if (req_.floating) {
+    xl[x_float_ + 2] = req_.floating->volume.theta_min;
+    xu[x_float_ + 2] = req_.floating->volume.theta_max;
+  }
+  for (int c = x_lambda_; c < nx_; ++c) xl[c] = 0;
+
+  gl = Eigen::VectorXd::Zero(ng_);
+  gu = Eigen::VectorXd::Zero(ng_);
+  if (req_.floating) {
+    const auto& f = *req_.floating;
+    std::vector<Eigen::Vector2d> n;
+    std::vector<double> b;
+    halfPlanes(f.volume.polygon, n, b);
+    int r = row_floating_;
+    for (double bi : b) gl[r] = -kInf, gu[r++] = bi;
+    n.clear(), b.clear();
+    halfPlanes(scene_->surfaces()[f.surface].polygon, n, b);
+    for (std::size_t k = 0; k < robot_->spots()[f.spot].polygon.size(); ++k)
+      for (double bi : b) gl[r] = -kInf, gu[r++] = bi;
+  }
+  for (const auto& j : robot_->joints()) {
+    const double W = robot_->totalMass() * 9.81;  // statics rows are in units of the weight
+    gl[row_statics_ + 6 + j.index] = -j.effort / W;
+    gu[row_statics_ + 6 + j.index] = j.effort / W;
+  }
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    gl[row_collision_ + k] = opt_.collision_margin;
+    gu[row_collision_ + k] = kInf;
+  }
+}
+
+Eigen::VectorXd PostureProblem::initialPoint() const {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(nx_);
+  Eigen::VectorXd xl, xu, gl, gu;
+  bounds(xl, xu, gl, gu);
+  x = x.cwiseMax(xl).cwiseMin(xu);  // a guess outside the joint limits starts on them
+  if (req_.floating) {
+    const auto& v = req_.floating->volume;
+    const Eigen::Vector2d c = v.polygon.centroid();
+    x[x_float_] = c.x();
+    x[x_float_ + 1] = c.y();
+    // Start from the spot's current heading when the volume allows it.
+    x[x_float_ + 2] = std::clamp(0.0, v.theta_min, v.theta_max);
+  }
+  // Forces: the least-squares balance of the weight at the initial guess
+  // (force and moment rows), kept non-negative.
+  if (n_lambda_ > 0) {
+    Kinematics k(robot_);
+    k.setConfiguration(req_.initial_guess);
+    const double M = robot_->totalMass();
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(6, n_lambda_);
+    for (const auto& s : supports_)
+      for (std::size_t c = 0; c < s.corners.size(); ++c)
+        for (std::size_t m = 0; m < s.generators.size(); ++m) {
+          const int col = s.lambda0 + static_cast<int>(c * s.generators.size() + m) - x_lambda_;
+          A.block<3, 1>(0, col) = s.generators[m];
+          A.block<3, 1>(3, col) = s.corners[c].cross(s.generators[m]);
+        }
+    Eigen::VectorXd b(6);
+    b.head<3>() = Eigen::Vector3d(0, 0, 1);  // in units of the weight
+    b.tail<3>() = k.centerOfMass().cross(Eigen::Vector3d(0, 0, 1));
+    (void)M;
+    const Eigen::MatrixXd AtA = A.transpose() * A + 1e-3 * Eigen::MatrixXd::Identity(n_lambda_, n_lambda_);
+    Eigen::VectorXd lam = AtA.ldlt().solve(A.transpose() * b);
+    // a few projected gradient steps toward the non-negative least-squares solution
+    const double step = 1.0 / AtA.norm();
+    for (int it = 0; it < 200; ++it) lam = (lam - step * (AtA * lam - A.transpose() * b)).cwiseMax(0.0);
+    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(1e-4);
+  }
+  return x;
+}
+
+Configuration PostureProblem::configurationAt(const Eigen::VectorXd& x) const {
+  const Configuration& q0 = req_.initial_guess;
+  Configuration q = q0;
+  q.base_position = q0.base_position + x.segment<3>(0);
+  q.base_orientation = Eigen::Quaterniond(expSO3(x.segment<3>(3)) * q0.base_orientation.toRotationMatrix());
+  q.joints = q0.joints + x.segment(6, robot_->numJoints());
+  return q;
+}
+
+SurfacePlacement PostureProblem::floatingAt(const Eigen::VectorXd& x) const {
+  SurfacePlacement p;
+  if (req_.floating) p.x = x[x_float_], p.y = x[x_float_ + 1], p.theta = x[x_float_ + 2];
+  return p;
+}
+
+std::vector<PostureProblem::ContactForces> PostureProblem::forcesAt(const Eigen::VectorXd& x) const {
+  std::vector<ContactForces> out;
+  for (const auto& s : supports_) {
+    ContactForces cf;
+    cf.contact = s.contact;
+    cf.points = s.corners;
+    for (std::size_t k = 0; k < s.corners.size(); ++k) {
+      Eigen::Vector3d f = Eigen::Vector3d::Zero();
+      for (std::size_t m = 0; m < s.generators.size(); ++m)
+        f += x[s.lambda0 + k * s.generators.size() + m] * s.generators[m];
+      cf.forces.push_back(robot_->totalMass() * 9.81 * f);
+    }
+    out.push_back(cf);
+  }
+  return out;
+}
+
+Eigen::Matrix3d PostureProblem::leftJacobian(const Eigen::Vector3d& w) const {
+  // d/de exp(w + e v) = [J_l(w) v]x exp(w): maps rotation-vector steps to world rotations.
+  const double th = w.norm();
+  const Eigen::Matrix3d W = skew(w);
+  if (th < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 6.0;
+  return Eigen::Matrix3d::Identity() + (1 - std::cos(th)) / (th * th) * W + (th - std::sin(th)) / (th * th * th) * W * W;
+}
+
+void PostureProblem::evaluate(const Eigen::VectorXd& x) {
+  if (valid_ && x.size() == x_cached_.size() && x == x_cached_) return;
+  const Configuration q = configurationAt(x);
+  kin_.setConfiguration(q);
+  const RobotModel& m = *robot_;
+  g_ = Eigen::VectorXd::Zero(ng_);
+  jac_ = Eigen::MatrixXd::Zero(ng_, nx_);
+  Eigen::VectorXd row(nq_);
+
+  // Cost.
+  grad_f_ = Eigen::VectorXd::Zero(nx_);
+  Eigen::VectorXd gq = Eigen::VectorXd::Zero(nq_);
+  f_ = req_.cost->evaluate(kin_, gq);
+  grad_f_.head(nq_) = gq;
+  const Eigen::VectorXd lam = x.segment(x_lambda_, n_lambda_);
+  f_ += opt_.force_regularization * lam.squaredNorm();
+  grad_f_.segment(x_lambda_, n_lambda_) = 2 * opt_.force_regularization * lam;
+
+  // Contacts.
+  const int n_fixed = static_cast<int>(req_.contacts.size());
+  for (int ci = 0; ci < n_fixed + (req_.floating ? 1 : 0); ++ci) {
+    const bool floating = ci == n_fixed;
+    const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
+    const Surface& surf = scene_->surfaces()[floating ? req_.floating->surface : req_.contacts[ci].surface];
+    const SurfacePlacement pl = floating ? floatingAt(x) : req_.contacts[ci].placement;
+    const int link = m.spots()[spot].link;
+    const Eigen::Isometry3d Ts = kin_.spotPose(spot);
+    const Eigen::Isometry3d T = contactFrame(surf, pl);
+    const int r = 6 * ci;
+    g_.segment<3>(r) = Ts.translation() - T.translation();
+    jac_.block(r, 0, 3, nq_) = kin_.chainPointJacobian(link, Ts.translation());
+    const Eigen::Vector3d zs = Ts.linear().col(2), xs = Ts.linear().col(0);
+    const Eigen::Vector3d xt = T.linear().col(0), yt = T.linear().col(1);
+    const std::pair<Eigen::Vector3d, Eigen::Vector3d> axes[3] = {{zs, xt}, {zs, yt}, {xs, yt}};
+    for (int k = 0; k < 3; ++k) {
+      g_[r + 3 + k] = axes[k].first.dot(axes[k].second);
+      row.setZero();
+      kin_.addAxisGradient(link, axes[k].first, axes[k].second, row);
+      jac_.block(r + 3 + k, 0, 1, nq_) = row.transpose();
+    }
+    if (floating) {
+      const Eigen::Matrix3d SR = surf.frame.linear();
+      jac_.block(r, x_float_, 3, 1) = -SR.col(0);
+      jac_.block(r, x_float_ + 1, 3, 1) = -SR.col(1);
+      // d x_t / d theta = y_t, d y_t / d theta = -x_t
+      jac_(r + 3, x_float_ + 2) = zs.dot(yt);
+      jac_(r + 4, x_float_ + 2) = -zs.dot(xt);
+      jac_(r + 5, x_float_ + 2) = -xs.dot(xt);
+    }
+  }
+
+  // Floating contact inside its search volume, and its spot polygon on the surface.
+  if (req_.floating) {
+    const auto& f = *req_.floating;
+    const Eigen::Vector2d p(x[x_float_], x[x_float_ + 1]);
+    const double th = x[x_float_ + 2];
+    std::vector<Eigen::Vector2d> n;
+    std::vector<double> b;
+    halfPlanes(f.volume.polygon, n, b);
+    int r = row_floating_;
+    for (const auto& ne : n) {
+      g_[r] = ne.dot(p);
+      jac_(r, x_float_) = ne.x();
+      jac_(r, x_float_ + 1) = ne.y();
+      ++r;
+    }
+    n.clear(), b.clear();
+    halfPlanes(scene_->surfaces()[f.surface].polygon, n, b);
+    const Eigen::Matrix2d R = Eigen::Rotation2Dd(th).toRotationMatrix();
+    Eigen::Matrix2d dR;
+    dR << -std::sin(th), -std::cos(th), std::cos(th), -std::sin(th);
+    for (const auto& c : m.spots()[f.spot].polygon.vertices())
+      for (const auto& ne : n) {
+        g_[r] = ne.dot(p + R * c);
+        jac_(r, x_float_) = ne.x();
+        jac_(r, x_float_ + 1) = ne.y();
+        jac_(r, x_float_ + 2) = ne.dot(dR * c);
+        ++r;
+      }
+  }
+
+  // Statics: h = g(q) - sum J^T f, forces applied at the supporting contacts'
+  // target corners (constant points: they coincide with the spot's corners
+  // when the contact rows hold).
+  {
+    // Forces are W lambda g (lambda in units of the body weight W) and the rows
+    // are divided by W: every statics row and variable is of order one.
+    const int r0 = row_statics_;
+    const double M = m.totalMass();
+    const double W = M * 9.81;
+    const Eigen::Vector3d G = M * kGravity;
+    std::vector<Eigen::Vector3d> S(m.numJoints(), Eigen::Vector3d::Zero());  // subtree sum m_l c_l
+    Eigen::Vector3d Sc = Eigen::Vector3d::Zero();
+    for (const auto& l : m.links()) {
+      const Eigen::Vector3d cl = kin_.linkPose(l.index) * l.com;
+      Sc += l.mass * cl;
+      for (int j : m.ancestorJoints(l.index)) S[j] += l.mass * cl;
+    }
+    const Eigen::Vector3d c = Sc / M;
+    const Eigen::Vector3d pb = kin_.linkPose(0).translation();
+    std::vector<Eigen::Vector3d> C(m.numJoints());
+    for (const auto& j : m.joints()) C[j.index] = S[j.index] / m.subtreeMass(j.index);
+
+    // Forces at corners; per joint: F_j (sum of forces below j), Q_j (their moment about o_j).
+    std::vector<Eigen::Vector3d> F(m.numJoints(), Eigen::Vector3d::Zero()), Q(m.numJoints(), Eigen::Vector3d::Zero());
+    Eigen::Vector3d Ftot = Eigen::Vector3d::Zero(), Mtot = Eigen::Vector3d::Zero();
+    for (const auto& s : supports_) {
+      const int ng = static_cast<int>(s.generators.size());
+      for (std::size_t k = 0; k < s.corners.size(); ++k) {
+        Eigen::Vector3d f = Eigen::Vector3d::Zero();
+        for (int mm = 0; mm < ng; ++mm) f += W * x[s.lambda0 + k * ng + mm] * s.generators[mm];
+        Ftot += f;
+        Mtot += s.corners[k].cross(f);
+        for (int j : m.ancestorJoints(s.link)) {
+          F[j] += f;
+          Q[j] += (s.corners[k] - kin_.jointOrigin(j)).cross(f);
+        }
+        for (int mm = 0; mm < ng; ++mm) {
+          const int col = s.lambda0 + static_cast<int>(k) * ng + mm;
+          const Eigen::Vector3d& gm = s.generators[mm];
+          jac_.block(r0, col, 3, 1) = -gm;
+          jac_.block(r0 + 3, col, 3, 1) = -s.corners[k].cross(gm);
+          for (int j : m.ancestorJoints(s.link))
+            jac_(r0 + 6 + j, col) = -kin_.jointAxis(j).dot((s.corners[k] - kin_.jointOrigin(j)).cross(gm));
+        }
+      }
+    }
+    g_.segment<3>(r0) = (-G - Ftot) / W;
+    g_.segment<3>(r0 + 3) = (-c.cross(G) - Mtot) / W;
+    // d(-(c x G)) = G x dc, with the centre of mass Jacobian from the chain.
+    Eigen::MatrixXd Jc = Eigen::MatrixXd::Zero(3, nq_);
+    Jc.block<3, 3>(0, 0).setIdentity();
+    Jc.block<3, 3>(0, 3) = -skew(c - pb);
+    for (const auto& j : m.joints())
+      Jc.col(6 + j.index) = m.subtreeMass(j.index) / M *
+                            kin_.jointAxis(j.index).cross(C[j.index] - kin_.jointOrigin(j.index));
+    jac_.block(r0 + 3, 0, 3, nq_) = skew(G) * Jc / W;
+
+    for (const auto& j : m.joints()) {
+      const int jj = j.index;
+      const Eigen::Vector3d& a = kin_.jointAxis(jj);
+      const Eigen::Vector3d& o = kin_.jointOrigin(jj);
+      const double Mj = m.subtreeMass(jj);
+      const Eigen::Vector3d mj = (C[jj] - o).cross(Mj * kGravity) + Q[jj];
+      const int r = r0 + 6 + jj;
+      g_[r] = -a.dot(mj) / W;
+      // Base translation: o_j and C_j move together, the corners stay.
+      jac_.block(r, 0, 1, 3) = F[jj].cross(a).transpose() / W;
+      // A rotation omega about a point o_i above joint j (base rotation or ancestor joint).
+      auto above = [&](const Eigen::Vector3d& w, const Eigen::Vector3d& oi) {
+        const Eigen::Vector3d da = w.cross(a);
+        const Eigen::Vector3d dO = w.cross(o - oi);
+        const Eigen::Vector3d dm = (w.cross(C[jj] - o)).cross(Mj * kGravity) - dO.cross(F[jj]);
+        return -(da.dot(mj) + a.dot(dm));
+      };
+      for (int k = 0; k < 3; ++k) jac_(r, 3 + k) = above(Eigen::Vector3d::Unit(k), pb) / W;
+      for (const auto& i : m.joints()) {
+        const int ii = i.index;
+        if (ii != jj && m.jointMovesLink(ii, j.child_link)) {
+          jac_(r, 6 + ii) = above(kin_.jointAxis(ii), kin_.jointOrigin(ii)) / W;
+        } else if (m.jointMovesLink(jj, i.child_link)) {
+          // joint j itself or below it: only the subtree's centre of mass moves
+          const Eigen::Vector3d dm =
+              (m.subtreeMass(ii) * kin_.jointAxis(ii).cross(C[ii] - kin_.jointOrigin(ii))).cross(kGravity);
+          jac_(r, 6 + ii) = -a.dot(dm) / W;
+        }
+      }
+    }
+  }
+
+  // Collisions.
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const PairDistance d = collision_->pairDistance(kin_, pairs_[k], true);
+    g_[row_collision_ + k] = d.distance;
+    jac_.block(row_collision_ + k, 0, 1, nq_) = d.gradient.transpose();
+  }
+
+  // Chain rule for the base rotation vector: tangent rotation = J_l(w) dw.
+  const Eigen::Matrix3d Jl = leftJacobian(x.segment<3>(3));
+  jac_.middleCols(3, 3) = jac_.middleCols(3, 3) * Jl;
+  grad_f_.segment<3>(3) = Jl.transpose() * grad_f_.segment<3>(3);
+
+  x_cached_ = x;
+  valid_ = true;
+}
+
+double PostureProblem::cost(const Eigen::VectorXd& x) {
+  evaluate(x);
+  return f_;
+}
+Eigen::VectorXd PostureProblem::costGradient(const Eigen::VectorXd& x) {
+  evaluate(x);
+  return grad_f_;
+}
+Eigen::VectorXd PostureProblem::constraints(const Eigen::VectorXd& x) {
+  evaluate(x);
+  return g_;
+}
+const Eigen::MatrixXd& PostureProblem::constraintJacobian(const Eigen::VectorXd& x) {
+  evaluate(x);
+  return jac_;
+}
+void PostureProblem::jacobianValues(const Eigen::VectorXd& x, double* values) {
+  evaluate(x);
+  for (std::size_t k = 0; k < structure_.size(); ++k) values[k] = jac_(structure_[k].first, structure_[k].second);
+}
+
+}  // namespace acyclic

@@ -1,0 +1,133 @@
+#pragma once
+// The posture generator's nonlinear program (DESIGN.md section 6), evaluated
+// without Ipopt so that every derivative can be tested on its own.
+//
+// Variables x = [ configuration (tangent offset from the initial guess: base
+// translation, base rotation vector R = exp(w) R0, joints) | floating contact
+// (x, y, theta) if any | friction-pyramid coefficients lambda >= 0, 4 per
+// corner of each supporting contact, in units of the robot's weight ].
+//
+// Constraints (rows, in this order):
+//   contacts    6 per contact: spot origin on its target point (3); spot z
+//               along the surface normal (2: z_s . x_t = z_s . y_t = 0); in-plane
+//               angle (1: x_s . y_t = 0)
+//   floating    (x, y) inside the search polygon; each spot-polygon corner
+//               inside the surface polygon
+//   statics     h = (g(q) - sum J^T f) / weight over the supporting contacts' corners:
+//               6 base rows = 0 (forces; moments about the world origin),
+//               30 joint rows within the torque limits
+//   collision   signed distance >= margin for each active pair
+// Contacts that are not supporting (being added or removed) are geometric only.
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "planner/collision/collision_model.h"
+#include "planner/posture/posture_cost.h"
+#include "planner/scene/scenario.h"
+
+namespace acyclic {
+
+// The floating contact's search volume C_i: (x, y) in a convex polygon of the
+// surface frame, theta in [theta_min, theta_max].
+struct SearchVolume {
+  ConvexPolygon polygon;
+  double theta_min = -M_PI;
+  double theta_max = M_PI;
+};
+
+struct FloatingContact {
+  int spot = -1;
+  int surface = -1;
+  SearchVolume volume;
+};
+
+struct PostureRequest {
+  std::vector<ContactSpec> contacts;        // fixed contacts (placement given)
+  std::optional<FloatingContact> floating;  // at most one, geometric only
+  Configuration initial_guess;
+  std::shared_ptr<const PostureCost> cost;  // default: distance to the initial guess
+};
+
+struct PostureOptions {
+  double collision_margin = 0.005;   // m
+  double collision_cutoff = 0.15;    // m: pairs farther than this at the start are left out
+  int pyramid_sides = 4;             // generators per corner (inscribed friction pyramid)
+  double force_regularization = 1e-4;  // small cost on lambda^2 (lambda in body weights): unique forces
+};
+
+class PostureProblem {
+ public:
+  // Throws std::invalid_argument on a request that cannot be posed (with the reason).
+  PostureProblem(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                 std::shared_ptr<const CollisionModel> collision, const PostureRequest& request,
+                 const PostureOptions& options);
+
+  int numVariables() const { return nx_; }
+  int numConstraints() const { return ng_; }
+  void bounds(Eigen::VectorXd& x_lo, Eigen::VectorXd& x_hi, Eigen::VectorXd& g_lo, Eigen::VectorXd& g_hi) const;
+  Eigen::VectorXd initialPoint() const;
+  // Sparsity of the constraint Jacobian (row, column), fixed for the problem.
+  const std::vector<std::pair<int, int>>& jacobianStructure() const { return structure_; }
+
+  double cost(const Eigen::VectorXd& x);
+  Eigen::VectorXd costGradient(const Eigen::VectorXd& x);
+  Eigen::VectorXd constraints(const Eigen::VectorXd& x);
+  const Eigen::MatrixXd& constraintJacobian(const Eigen::VectorXd& x);  // dense, rows x variables
+  void jacobianValues(const Eigen::VectorXd& x, double* values);       // in structure order
+
+  Configuration configurationAt(const Eigen::VectorXd& x) const;
+  SurfacePlacement floatingAt(const Eigen::VectorXd& x) const;
+  // World corner points and forces of each supporting contact.
+  struct ContactForces {
+    int contact = -1;  // index into the request's contacts
+    std::vector<Eigen::Vector3d> points, forces;
+  };
+  std::vector<ContactForces> forcesAt(const Eigen::VectorXd& x) const;
+
+  // Row ranges, for reports and tests.
+  int contactRows() const { return row_floating_; }
+  int statics_row() const { return row_statics_; }
+  int collisionRow() const { return row_collision_; }
+  const std::vector<int>& collisionPairs() const { return pairs_; }
+  // Adds pairs to the collision rows (constraint generation); re-plans the layout.
+  void addCollisionPairs(const std::vector<int>& pairs);
+
+ private:
+  struct Support {             // a supporting contact's force model
+    int contact;
+    int link;
+    std::vector<Eigen::Vector3d> corners;  // world (target) points
+    std::vector<Eigen::Vector3d> generators;  // unit, world
+    int lambda0;               // first lambda variable
+  };
+  void layout();
+  void evaluate(const Eigen::VectorXd& x);
+  Eigen::Matrix3d leftJacobian(const Eigen::Vector3d& w) const;
+
+  std::shared_ptr<const RobotModel> robot_;
+  std::shared_ptr<const Scene> scene_;
+  std::shared_ptr<const CollisionModel> collision_;
+  PostureRequest req_;
+  PostureOptions opt_;
+  Kinematics kin_;
+  std::vector<Support> supports_;
+  std::vector<int> pairs_;
+  std::vector<std::pair<int, int>> allowed_touch_;  // (link, obstacle)
+
+  int nq_ = 0, nx_ = 0, ng_ = 0;
+  int x_float_ = -1, x_lambda_ = -1, n_lambda_ = 0;
+  int row_floating_ = 0, n_float_rows_ = 0, row_statics_ = 0, row_collision_ = 0;
+  std::vector<std::pair<int, int>> structure_;
+
+  // Evaluation cache.
+  bool valid_ = false;
+  Eigen::VectorXd x_cached_;
+  double f_ = 0;
+  Eigen::VectorXd grad_f_, g_;
+  Eigen::MatrixXd jac_;
+};
+
+}  // namespace acyclic
