@@ -26,7 +26,7 @@ int printReport(const acyclic::ValidityReport& r) {
 int main(int argc, char** argv) {
   CLI::App app{
       "Checks a scenario's start stance against Acyclic's validity contract (DESIGN.md section 9):\n"
-      "joint limits, contacts, collisions (equilibrium: with the posture-generator issue).\n"
+      "joint limits, contacts, collisions, quasi-static equilibrium.\n"
       "Exit status: 0 valid, 1 a violation, 2 bad input."};
   std::string scenario_path;
   app.add_option("scenario", scenario_path, "scenario file (format acyclic.scenario/1)")->required();

@@ -24,7 +24,7 @@ bool ValidityReport::valid() const {
 
 ValidityChecker::ValidityChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
                                  ContractTolerances tol)
-    : robot_(robot), scene_(scene), tol_(tol), kin_(robot), collision_(robot, scene) {}
+    : robot_(robot), scene_(scene), tol_(tol), kin_(robot), collision_(robot, scene), statics_(robot, scene) {}
 
 ValidityReport ValidityChecker::checkPosture(const Configuration& q, const std::vector<ContactSpec>& stance) {
   ValidityReport r;
@@ -32,12 +32,23 @@ ValidityReport ValidityChecker::checkPosture(const Configuration& q, const std::
   kin_.setConfiguration(q);
   r.parts.push_back(checkContacts(stance));
   r.parts.push_back(checkCollisions(stance));
-  CheckPart eq;
-  eq.name = "equilibrium";
-  eq.checked = false;
-  eq.summary = "not checked: the quasi-static check arrives with the posture generator";
-  r.parts.push_back(eq);
+  r.parts.push_back(checkEquilibrium(stance));
   return r;
+}
+
+CheckPart ValidityChecker::checkEquilibrium(const std::vector<ContactSpec>& stance, QuasiStaticReport* out) {
+  CheckPart p;
+  p.name = "equilibrium";
+  const QuasiStaticReport q = statics_.check(kin_, stance);
+  if (!q.feasible) p.violations.push_back(q.reason);
+  std::ostringstream os;
+  os << q.supporting_contacts << " supporting contacts; friction margin " << fmt("%.1f", q.margin)
+     << " N; worst torque " << fmt("%.0f", q.worst_torque_ratio * 100) << "% of its limit ("
+     << (q.worst_joint.empty() ? "-" : q.worst_joint) << "); balance residual " << fmt("%.1e", q.residual)
+     << " of the weight";
+  p.summary = os.str();
+  if (out) *out = q;
+  return p;
 }
 
 CheckPart ValidityChecker::checkJointLimits(const Configuration& q) const {

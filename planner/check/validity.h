@@ -3,11 +3,11 @@
 // posture and its stance. Each part reports what it checked, its worst figure
 // and every violation with its figure.
 //
-// Equilibrium is not checked here yet: it arrives with the independent
-// quasi-static check (posture-generator issue), and the report says so.
+// Equilibrium is checked by the independent quasi-static LP (quasi_static.h).
 #include <string>
 #include <vector>
 
+#include "planner/check/quasi_static.h"
 #include "planner/collision/collision_model.h"
 #include "planner/model/kinematics.h"
 #include "planner/scene/scenario.h"
@@ -45,6 +45,8 @@ class ValidityChecker {
   CheckPart checkJointLimits(const Configuration& q) const;
   CheckPart checkContacts(const std::vector<ContactSpec>& stance);    // at the last set configuration
   CheckPart checkCollisions(const std::vector<ContactSpec>& stance);  // idem
+  CheckPart checkEquilibrium(const std::vector<ContactSpec>& stance,
+                             QuasiStaticReport* report = nullptr);  // idem
 
  private:
   std::shared_ptr<const RobotModel> robot_;
@@ -52,6 +54,7 @@ class ValidityChecker {
   ContractTolerances tol_;
   Kinematics kin_;
   CollisionModel collision_;
+  QuasiStaticChecker statics_;
 };
 
 }  // namespace acyclic

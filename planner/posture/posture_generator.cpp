@@ -6,6 +6,8 @@
 #include <IpIpoptApplication.hpp>
 #include <IpTNLP.hpp>
 
+extern "C" int acyclic_mumps_lock_linked();  // planner/posture/mumps_lock.cpp
+
 namespace acyclic {
 
 const char* toString(PostureResult::Status s) {
@@ -110,6 +112,7 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
     : robot_(std::move(robot)), scene_(std::move(scene)),
       collision_(std::make_shared<CollisionModel>(robot_, scene_)), opt_(options),
       ipopt_(std::make_unique<Ipopt>()) {
+  (void)acyclic_mumps_lock_linked();  // keeps the lock library in every link
   auto& app = ipopt_->app;
   app = IpoptApplicationFactory();
   auto o = app->Options();
@@ -127,6 +130,9 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   o->SetNumericValue("acceptable_compl_inf_tol", 1e-3);
   o->SetNumericValue("acceptable_obj_change_tol", 1e-3);
   o->SetIntegerValue("acceptable_iter", 3);
+  // Out-of-reach contacts are common in the search: enter the restoration
+  // phase early, so that local infeasibility is found fast.
+  o->SetStringValue("expect_infeasible_problem", "yes");
   o->SetIntegerValue("max_iter", opt_.max_iterations);
   o->SetNumericValue("max_cpu_time", opt_.max_seconds);
   if (app->Initialize() != ::Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialize");

@@ -194,7 +194,7 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
     xl[x_float_ + 2] = req_.floating->volume.theta_min;
     xu[x_float_ + 2] = req_.floating->volume.theta_max;
   }
-  for (int c = x_lambda_; c < nx_; ++c) xl[c] = 0;
+  for (int c = x_lambda_; c < nx_; ++c) xl[c] = opt_.min_force_coefficient;
 
   gl = Eigen::VectorXd::Zero(ng_);
   gu = Eigen::VectorXd::Zero(ng_);
@@ -212,8 +212,8 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
   }
   for (const auto& j : robot_->joints()) {
     const double W = robot_->totalMass() * 9.81;  // statics rows are in units of the weight
-    gl[row_statics_ + 6 + j.index] = -j.effort / W;
-    gu[row_statics_ + 6 + j.index] = j.effort / W;
+    gl[row_statics_ + 6 + j.index] = -opt_.torque_share * j.effort / W;
+    gu[row_statics_ + 6 + j.index] = opt_.torque_share * j.effort / W;
   }
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
     gl[row_collision_ + k] = opt_.collision_margin;
@@ -257,7 +257,7 @@ Eigen::VectorXd PostureProblem::initialPoint() const {
     // a few projected gradient steps toward the non-negative least-squares solution
     const double step = 1.0 / AtA.norm();
     for (int it = 0; it < 200; ++it) lam = (lam - step * (AtA * lam - A.transpose() * b)).cwiseMax(0.0);
-    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(1e-4);
+    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(opt_.min_force_coefficient);
   }
   return x;
 }

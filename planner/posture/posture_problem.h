@@ -55,6 +55,12 @@ struct PostureOptions {
   double collision_margin = 0.005;   // m
   double collision_cutoff = 0.15;    // m: pairs farther than this at the start are left out
   int pyramid_sides = 4;             // generators per corner (inscribed friction pyramid)
+  // Margins that keep a solution strictly inside what the independent check
+  // accepts (an optimum sits on its constraints' boundary): every pyramid
+  // coefficient at least this (body weights), torques within this share of
+  // their limits.
+  double min_force_coefficient = 2e-3;
+  double torque_share = 0.98;
   double force_regularization = 1e-4;  // small cost on lambda^2 (lambda in body weights): unique forces
 };
 

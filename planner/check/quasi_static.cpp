@@ -1,0 +1,178 @@
+#include "planner/check/quasi_static.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <coin/ClpSimplex.hpp>
+#include <coin/CoinPackedMatrix.hpp>
+
+namespace acyclic {
+
+namespace {
+
+// A sparse LP assembled row by row, solved by Clp.
+struct Lp {
+  int ncols = 0;
+  std::vector<int> ri, ci;
+  std::vector<double> v, rlo, rhi, clo, chi, obj;
+  int addCol(double lo, double hi, double c) {
+    clo.push_back(lo), chi.push_back(hi), obj.push_back(c);
+    return ncols++;
+  }
+  void addRow(const std::vector<std::pair<int, double>>& terms, double lo, double hi) {
+    const int r = static_cast<int>(rlo.size());
+    for (const auto& [c, a] : terms)
+      if (std::abs(a) > 1e-12) ri.push_back(r), ci.push_back(c), v.push_back(a);
+    rlo.push_back(lo), rhi.push_back(hi);
+  }
+  // Minimizes obj; returns false when infeasible (or failed).
+  bool solve(std::vector<double>& x) const {
+    CoinPackedMatrix M(false, ri.data(), ci.data(), v.data(), static_cast<CoinBigIndex>(v.size()));
+    M.setDimensions(static_cast<int>(rlo.size()), ncols);
+    ClpSimplex model;
+    model.setLogLevel(0);
+    model.loadProblem(M, clo.data(), chi.data(), obj.data(), rlo.data(), rhi.data());
+    model.initialSolve();
+    if (!model.isProvenOptimal()) return false;
+    x.assign(model.getColSolution(), model.getColSolution() + ncols);
+    return true;
+  }
+};
+
+}  // namespace
+
+QuasiStaticChecker::QuasiStaticChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
+    : robot_(std::move(robot)), scene_(std::move(scene)) {}
+
+QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const {
+  QuasiStaticReport rep;
+  const RobotModel& m = *robot_;
+  const int nt = m.tangentSize();
+  const double W = m.totalMass() * 9.81;
+  const Eigen::VectorXd g = kin.gravityTorques();  // Simbody
+
+  // Corners of the supporting contacts, their surface axes, and J^T columns (Simbody).
+  struct Corner {
+    int contact;
+    Eigen::Vector3d p, n, t1, t2;
+    double mu;
+    Eigen::MatrixXd JT;  // nt x 3
+  };
+  std::vector<Corner> corners;
+  for (std::size_t ci = 0; ci < stance.size(); ++ci) {
+    const ContactSpec& c = stance[ci];
+    if (!c.supporting) continue;
+    ++rep.supporting_contacts;
+    const ContactSpot& spot = m.spots()[c.spot];
+    const Surface& s = scene_->surfaces()[c.surface];
+    const Eigen::Isometry3d Tspot = kin.spotPose(c.spot);
+    for (const auto& v : spot.polygon.vertices()) {
+      Corner k;
+      k.contact = static_cast<int>(ci);
+      const Eigen::Vector3d in_spot(v.x(), v.y(), 0);
+      k.p = Tspot * in_spot;
+      k.n = s.frame.linear().col(2);
+      k.t1 = s.frame.linear().col(0);
+      k.t2 = s.frame.linear().col(1);
+      k.mu = s.friction;
+      k.JT = kin.pointJacobian(spot.link, spot.frame * in_spot).transpose();
+      corners.push_back(k);
+    }
+  }
+  if (corners.empty()) {
+    rep.reason = "no supporting contact";
+    return rep;
+  }
+
+  // Columns: per corner (f_n, f_t1, f_t2), then the LP's own variable (s or t).
+  auto build = [&](Lp& lp, bool margin_lp) {
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+      lp.addCol(0, COIN_DBL_MAX, 0);
+      lp.addCol(-COIN_DBL_MAX, COIN_DBL_MAX, 0);
+      lp.addCol(-COIN_DBL_MAX, COIN_DBL_MAX, 0);
+    }
+    const int extra = margin_lp ? lp.addCol(-W, W, -1.0)   // maximize s
+                                : lp.addCol(0, COIN_DBL_MAX, 1.0);  // minimize t
+    // Generalized force rows: (J^T f)_i for each tangent index i.
+    for (int i = 0; i < nt; ++i) {
+      std::vector<std::pair<int, double>> row;
+      for (std::size_t k = 0; k < corners.size(); ++k) {
+        const Corner& c = corners[k];
+        row.push_back({3 * k, c.JT.row(i).dot(c.n)});
+        row.push_back({3 * k + 1, c.JT.row(i).dot(c.t1)});
+        row.push_back({3 * k + 2, c.JT.row(i).dot(c.t2)});
+      }
+      if (i < 6) {
+        lp.addRow(row, g[i], g[i]);  // the base: forces and moments balance gravity
+      } else {
+        const double lim = m.joints()[i - 6].effort;
+        if (margin_lp) {
+          lp.addRow(row, g[i] - lim, g[i] + lim);  // |g - J^T f| <= limit
+        } else {
+          // |g_i - (J^T f)_i| <= t lim:  (J^T f)_i + t lim >= g_i  and  (J^T f)_i - t lim <= g_i
+          auto r1 = row, r2 = row;
+          r1.push_back({extra, lim});
+          r2.push_back({extra, -lim});
+          lp.addRow(r1, g[i], COIN_DBL_MAX);
+          lp.addRow(r2, -COIN_DBL_MAX, g[i]);
+        }
+      }
+    }
+    // Friction pyramid: mu f_n -+ f_ti >= s (LP 1) or >= 0 (LP 2).
+    for (std::size_t k = 0; k < corners.size(); ++k)
+      for (int t = 1; t <= 2; ++t)
+        for (double sign : {1.0, -1.0}) {
+          std::vector<std::pair<int, double>> row = {{3 * k, corners[k].mu}, {3 * k + t, -sign}};
+          if (margin_lp) row.push_back({extra, -1.0});
+          lp.addRow(row, 0, COIN_DBL_MAX);
+        }
+    return extra;
+  };
+
+  // LP 2 first: forces in their pyramids that balance gravity, with the
+  // smallest worst torque ratio; infeasible only when no forces balance at all.
+  Lp lp2;
+  const int t_col = build(lp2, false);
+  std::vector<double> x2;
+  if (!lp2.solve(x2)) {
+    rep.reason = "no contact forces inside the friction pyramids balance gravity (the centre of mass is outside the support)";
+    return rep;
+  }
+  rep.worst_torque_ratio = x2[t_col];
+  // LP 1: how far inside the pyramids the forces can stay, torques within limits.
+  Lp lp1;
+  const int s_col = build(lp1, true);
+  std::vector<double> x1;
+  rep.margin = lp1.solve(x1) ? x1[s_col] : -std::numeric_limits<double>::infinity();
+
+  // Forces, torques and the balance residual at LP 2's solution.
+  Eigen::VectorXd JTf = Eigen::VectorXd::Zero(nt);
+  rep.points.assign(stance.size(), {});
+  rep.forces.assign(stance.size(), {});
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const Corner& c = corners[k];
+    const Eigen::Vector3d f = x2[3 * k] * c.n + x2[3 * k + 1] * c.t1 + x2[3 * k + 2] * c.t2;
+    JTf += c.JT * f;
+    rep.points[c.contact].push_back(c.p);
+    rep.forces[c.contact].push_back(f);
+  }
+  const Eigen::VectorXd tau = g - JTf;
+  rep.residual = tau.head<6>().norm() / W;
+  double worst = 0;
+  for (const auto& j : m.joints()) {
+    const double r = std::abs(tau[6 + j.index]) / j.effort;
+    if (r > worst) worst = r, rep.worst_joint = j.name;
+  }
+  rep.feasible = worst <= 1 + 1e-9 && rep.margin >= -1e-9 && rep.residual <= residualTolerance();
+  if (!rep.feasible) {
+    std::ostringstream os;
+    if (worst > 1 + 1e-9) os << "the least torque needs " << worst << " times the limit at " << rep.worst_joint;
+    else if (rep.margin < -1e-9) os << "no forces within both the friction pyramids and the torque limits";
+    else os << "balance residual " << rep.residual << " of the weight";
+    rep.reason = os.str();
+  }
+  return rep;
+}
+
+}  // namespace acyclic

@@ -1,0 +1,49 @@
+#pragma once
+// Independent quasi-static feasibility check (DESIGN.md sections 6 and 9): an
+// LP over contact forces at the corners of each supporting contact, built from
+// Simbody's gravity torques and station Jacobians only. It shares no code with
+// the posture generator beyond the model, and uses the contract's friction
+// pyramid (|f_t1|, |f_t2| <= mu f_n), not the generator's inscribed one.
+//
+// LP 1: the largest margin s such that mu f_n - |f_ti| >= s at every corner,
+//       subject to force and moment balance and |tau_j| <= limit.
+// LP 2: the smallest worst torque ratio max_j |tau_j| / limit_j, forces in
+//       their pyramids, balance exact.
+// tau = g(q) - sum J^T f (holding torques, kinematics.h).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "planner/model/kinematics.h"
+#include "planner/scene/scenario.h"
+
+namespace acyclic {
+
+struct QuasiStaticReport {
+  bool feasible = false;
+  std::string reason;               // why not, when infeasible
+  double margin = 0;                // N: LP 1's s (negative: friction must be exceeded)
+  double worst_torque_ratio = 0;    // LP 2's optimum (<= 1 when feasible)
+  std::string worst_joint;
+  double residual = 0;              // |force and moment balance| / weight, at LP 2's forces
+  int supporting_contacts = 0;
+  // Per supporting contact, in stance order: world corner points and forces (LP 2).
+  std::vector<std::vector<Eigen::Vector3d>> points, forces;
+};
+
+class QuasiStaticChecker {
+ public:
+  QuasiStaticChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene);
+  // At the kinematics' configuration, with the stance's supporting contacts.
+  QuasiStaticReport check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const;
+
+  double residualTolerance() const { return 1e-6; }  // relative, DESIGN.md section 9
+
+ private:
+  std::shared_ptr<const RobotModel> robot_;
+  std::shared_ptr<const Scene> scene_;
+};
+
+}  // namespace acyclic

@@ -1,0 +1,309 @@
+// The posture generator: its derivatives against finite differences, and the
+// cases of the posture-generator issue, each result re-verified by the
+// independent validity check (limits, contacts, collisions, quasi-static LP).
+#include <gtest/gtest.h>
+
+#include <random>
+#include <regex>
+#include <set>
+#include <thread>
+
+#include "planner/check/validity.h"
+#include "planner/posture/posture_generator.h"
+#include "test_support.h"
+
+using namespace acyclic;
+
+namespace {
+
+const Scenario& chair() {
+  static Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));
+  return sc;
+}
+
+ContactSpec contactOf(const Scenario& sc, const std::string& spot, const std::string& surface, bool supporting,
+                      const Configuration& at) {
+  Kinematics k(sc.robot);
+  k.setConfiguration(at);
+  ContactSpec c;
+  c.spot = sc.robot->spotIndex(spot);
+  c.surface = sc.scene->surfaceIndex(surface);
+  c.supporting = supporting;
+  c.placement = projectOnSurface(sc.scene->surfaces()[c.surface], k.spotPose(c.spot));
+  return c;
+}
+
+// Every part of the contract holds for the result (independent check).
+void expectValid(const Scenario& sc, const PostureResult& r, std::vector<ContactSpec> stance) {
+  ValidityChecker checker(sc.robot, sc.scene);
+  const ValidityReport rep = checker.checkPosture(r.configuration, stance);
+  for (const auto& p : rep.parts) {
+    EXPECT_TRUE(p.checked) << p.name;
+    EXPECT_TRUE(p.ok()) << p.name << ": " << p.summary << (p.violations.empty() ? "" : " | " + p.violations[0]);
+  }
+}
+
+Configuration perturbed(const Configuration& q, std::mt19937& rng, double joint_sigma, double base_sigma) {
+  std::normal_distribution<double> n(0, 1);
+  Configuration p = q;
+  for (int j = 0; j < p.joints.size(); ++j) p.joints[j] += joint_sigma * n(rng);
+  p.base_position += base_sigma * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  return p;
+}
+
+PostureRequest wristOnTable(const Scenario& sc) {
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  FloatingContact f;
+  f.spot = sc.robot->spotIndex("l_wrist");
+  f.surface = sc.scene->surfaceIndex("table_top");
+  f.volume.polygon = sc.scene->surfaces()[f.surface].polygon;  // anywhere on the table top
+  r.floating = f;
+  return r;
+}
+
+}  // namespace
+
+TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
+  const Scenario& sc = chair();
+  auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
+  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), {});
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0, 0.05);
+  for (int trial = 0; trial < 2; ++trial) {
+    Eigen::VectorXd x = p.initialPoint();
+    for (int i = 0; i < p.numVariables(); ++i) x[i] += i < sc.robot->tangentSize() + 3 ? n(rng) : std::abs(n(rng));
+    const Eigen::MatrixXd J = p.constraintJacobian(x);
+    const Eigen::VectorXd gf = p.costGradient(x);
+    Eigen::MatrixXd Jn(J.rows(), J.cols());
+    Eigen::VectorXd gn(x.size());
+    for (int i = 0; i < x.size(); ++i) {
+      const double h = 1e-6;
+      Eigen::VectorXd a = x, b = x;
+      a[i] += h;
+      b[i] -= h;
+      Jn.col(i) = (p.constraints(a) - p.constraints(b)) / (2 * h);
+      gn[i] = (p.cost(a) - p.cost(b)) / (2 * h);
+    }
+    EXPECT_LT(test::relativeError(gf, gn), 1e-6);
+    auto block = [&](int r0, int r1) {
+      return test::relativeError(J.middleRows(r0, r1 - r0), Jn.middleRows(r0, r1 - r0));
+    };
+    EXPECT_LT(block(0, p.contactRows()), 1e-6) << "contact rows";
+    EXPECT_LT(block(p.contactRows(), p.statics_row()), 1e-6) << "floating-contact rows";
+    EXPECT_LT(block(p.statics_row(), p.collisionRow()), 1e-6) << "statics rows";
+    EXPECT_LT(block(p.collisionRow(), p.numConstraints()), 1e-3) << "collision rows (GJK accuracy)";
+    // The declared sparsity covers every nonzero.
+    std::set<std::pair<int, int>> s(p.jacobianStructure().begin(), p.jacobianStructure().end());
+    for (int r = 0; r < J.rows(); ++r)
+      for (int c = 0; c < J.cols(); ++c)
+        if (std::abs(Jn(r, c)) > 1e-7) {
+          EXPECT_TRUE(s.count({r, c})) << "row " << r << " col " << c;
+        }
+  }
+}
+
+TEST(PostureProblem, StaticsRowsAreSimbodysGravityTorques) {
+  // With no contact force the joint rows are Simbody's g(q) / weight.
+  const Scenario& sc = chair();
+  auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  PostureProblem p(sc.robot, sc.scene, cm, r, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(p.numVariables());
+  const Eigen::VectorXd g = p.constraints(x);
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  const double W = sc.robot->totalMass() * 9.81;
+  const Eigen::VectorXd simbody = k.gravityTorques() / W;
+  EXPECT_LT((g.segment(p.statics_row(), 3) - simbody.head<3>()).norm(), 1e-12);
+  EXPECT_LT((g.segment(p.statics_row() + 6, 30) - simbody.tail(30)).norm(), 1e-12);
+}
+
+TEST(PostureGenerator, ChairStartFromPerturbedGuess) {  // (a)
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 3; ++trial) {
+    PostureRequest r;
+    r.contacts = sc.start_stance;
+    r.initial_guess = perturbed(sc.start, rng, 0.08, 0.03);
+    r.cost = std::make_shared<ReferencePostureCost>(sc.start);
+    const PostureResult res = pg.solve(r);
+    ASSERT_TRUE(res.success()) << toString(res.status) << ": " << res.reason;
+    expectValid(sc, res, sc.start_stance);
+    ASSERT_EQ(res.forces.size(), 4u);  // every start contact supports
+  }
+}
+
+TEST(PostureGenerator, HalfSittingDoubleSupport) {  // (b)
+  const Scenario& sc = chair();
+  const Configuration hs = sc.robot->posture("half_sitting");
+  Configuration at = hs;
+  at.base_position = Eigen::Vector3d(-0.6, -0.8, hs.base_position.z());  // in the open
+  const std::vector<ContactSpec> stance = {contactOf(sc, "r_sole", "floor", true, at),
+                                           contactOf(sc, "l_sole", "floor", true, at)};
+  PostureGenerator pg(sc.robot, sc.scene);
+  std::mt19937 rng(2);
+  PostureRequest r;
+  r.contacts = stance;
+  r.initial_guess = perturbed(at, rng, 0.1, 0.05);
+  r.cost = std::make_shared<ReferencePostureCost>(at);
+  const PostureResult res = pg.solve(r);
+  ASSERT_TRUE(res.success()) << toString(res.status) << ": " << res.reason;
+  expectValid(sc, res, stance);
+  // Both feet carry the weight: total normal force = weight.
+  double fz = 0;
+  for (const auto& c : res.forces)
+    for (const auto& f : c.forces) fz += f.z();
+  EXPECT_NEAR(fz, sc.robot->totalMass() * 9.81, 1e-3);
+}
+
+TEST(PostureGenerator, LeftWristAnywhereOnTheTable) {  // (c)
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  const PostureRequest r = wristOnTable(sc);
+  const PostureResult res = pg.solve(r);
+  ASSERT_TRUE(res.success()) << toString(res.status) << ": " << res.reason;
+  EXPECT_TRUE(sc.scene->surfaces()[r.floating->surface].polygon.contains({res.floating.x, res.floating.y}));
+  std::vector<ContactSpec> stance = sc.start_stance;
+  ContactSpec wrist;
+  wrist.spot = r.floating->spot;
+  wrist.surface = r.floating->surface;
+  wrist.supporting = false;  // being added: geometric only
+  wrist.placement = res.floating;
+  stance.push_back(wrist);
+  expectValid(sc, res, stance);
+}
+
+TEST(PostureGenerator, ContactOutOfReachIsInfeasibleWithinItsTimeLimit) {  // (d)
+  const Scenario& sc = chair();
+  PostureGeneratorOptions o;
+  o.max_seconds = 0.5;
+  PostureGenerator pg(sc.robot, sc.scene, o);
+  PostureRequest r = wristOnTable(sc);
+  // The far edge of the table, a metre from the seated robot's shoulder.
+  r.floating->volume.polygon = ConvexPolygon({{0.35, -0.1}, {0.4, -0.1}, {0.4, 0.1}, {0.35, 0.1}});
+  const PostureResult res = pg.solve(r);
+  EXPECT_EQ(res.status, PostureResult::Status::Infeasible) << toString(res.status) << ": " << res.reason;
+  EXPECT_FALSE(res.reason.empty());
+  EXPECT_LT(res.seconds, o.max_seconds * 1.5);
+}
+
+TEST(PostureGenerator, OneThighWithTheCenterOfMassFarOutsideFailsOnEquilibrium) {  // (e)
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  // All four start contacts kept in place; only the right thigh supports.
+  std::vector<ContactSpec> stance = sc.start_stance;
+  for (auto& c : stance) c.supporting = sc.robot->spots()[c.spot].name == "r_thigh";
+  PostureRequest r;
+  r.contacts = stance;
+  r.initial_guess = sc.start;
+  const PostureResult res = pg.solve(r);
+  EXPECT_FALSE(res.success()) << "balanced on one thigh strip";
+  // The same geometry with every contact supporting is feasible: equilibrium is what fails.
+  r.contacts = sc.start_stance;
+  EXPECT_TRUE(pg.solve(r).success());
+  // The independent check agrees on the sitting posture.
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  const QuasiStaticReport q = QuasiStaticChecker(sc.robot, sc.scene).check(k, stance);
+  EXPECT_FALSE(q.feasible);
+  EXPECT_FALSE(q.reason.empty());
+}
+
+TEST(PostureGenerator, TorqueLimitsBind) {  // (f)
+  // Standing on the right foot with the left foot held far forward (touching
+  // the floor, not supporting): the left hip pitch holds the left leg out, and
+  // no posture can take that load off it. With its limit cut to 3 N m the
+  // same request has no solution, and the check refuses the strong robot's
+  // posture, naming the joint.
+  const Scenario& sc = chair();
+  test::TempDir dir;
+  std::string urdf = test::readFile(test::sourcePath("models/hrp2/hrp2.urdf"));
+  const std::regex limit("(<joint name=\"LLEG_JOINT2\"[\\s\\S]*?effort=\")150(\")");
+  urdf = std::regex_replace(urdf, limit, "$013$2", std::regex_constants::format_first_only);
+  ASSERT_NE(urdf.find("effort=\"3\""), std::string::npos);
+  dir.write("hrp2.urdf", urdf);
+  dir.write("hrp2.yaml", test::readFile(test::sourcePath("models/hrp2/hrp2.yaml")));
+  auto weak = RobotModel::load(dir.path() + "/hrp2.yaml");
+
+  Configuration at = sc.robot->posture("half_sitting");
+  at.base_position.x() = -0.6;
+  at.base_position.y() = -0.8;
+  ContactSpec right = contactOf(sc, "r_sole", "floor", true, at);
+  ContactSpec left = contactOf(sc, "l_sole", "floor", false, at);
+  left.placement.x += 0.45;  // a long step forward, not yet supporting
+  PostureRequest r;
+  r.contacts = {right, left};
+  Configuration guess = at;
+  guess.joints[sc.robot->jointIndex("LLEG_JOINT2")] = -0.8;
+  guess.joints[sc.robot->jointIndex("LLEG_JOINT3")] = 0.4;
+  r.initial_guess = guess;
+
+  PostureGenerator strong_pg(sc.robot, sc.scene);
+  const PostureResult strong = strong_pg.solve(r);
+  ASSERT_TRUE(strong.success()) << toString(strong.status) << ": " << strong.reason;
+  expectValid(sc, strong, r.contacts);
+
+  PostureGenerator weak_pg(weak, sc.scene);
+  const PostureResult w = weak_pg.solve(r);
+  EXPECT_FALSE(w.success());
+  Kinematics k(weak);
+  k.setConfiguration(strong.configuration);
+  const QuasiStaticReport q = QuasiStaticChecker(weak, sc.scene).check(k, r.contacts);
+  EXPECT_FALSE(q.feasible);
+  EXPECT_NE(q.reason.find("LLEG_JOINT2"), std::string::npos) << q.reason;
+  EXPECT_GT(q.worst_torque_ratio, 1.0);
+}
+
+TEST(PostureGenerator, BadRequestsAreRefusedWithAReason) {
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  r.initial_guess.joints.resize(3);
+  PostureResult res = pg.solve(r);
+  EXPECT_EQ(res.status, PostureResult::Status::BadInput);
+  EXPECT_NE(res.reason.find("joints"), std::string::npos) << res.reason;
+  r.initial_guess = sc.start;
+  for (auto& c : r.contacts) c.supporting = false;
+  res = pg.solve(r);
+  EXPECT_EQ(res.status, PostureResult::Status::BadInput);
+  EXPECT_NE(res.reason.find("supporting"), std::string::npos) << res.reason;
+  r.contacts = sc.start_stance;
+  r.contacts.push_back(r.contacts[0]);
+  EXPECT_EQ(pg.solve(r).status, PostureResult::Status::BadInput);
+}
+
+TEST(PostureGenerator, TwoGeneratorsOnTwoThreadsAgreeWithOne) {
+  const Scenario& sc = chair();
+  std::vector<PostureRequest> reqs;
+  std::mt19937 rng(9);
+  for (int i = 0; i < 4; ++i) {
+    PostureRequest r;
+    r.contacts = sc.start_stance;
+    r.initial_guess = perturbed(sc.start, rng, 0.05, 0.02);
+    reqs.push_back(r);
+  }
+  auto run = [&](std::vector<Eigen::VectorXd>& out) {
+    PostureGenerator pg(sc.robot, sc.scene);
+    for (const auto& r : reqs) {
+      const PostureResult res = pg.solve(r);
+      EXPECT_TRUE(res.success()) << res.reason;
+      out.push_back(res.configuration.joints);
+    }
+  };
+  std::vector<Eigen::VectorXd> ref, a, b;
+  run(ref);
+  std::thread ta([&] { run(a); }), tb([&] { run(b); });
+  ta.join();
+  tb.join();
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    EXPECT_EQ(ref[i], a[i]) << i;
+    EXPECT_EQ(ref[i], b[i]) << i;
+  }
+}
