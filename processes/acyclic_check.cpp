@@ -1,35 +1,43 @@
-// acyclic-check: checks a scenario's start stance against the validity
-// contract (DESIGN.md section 9) and prints every check with its figures.
-// Exit status: 0 valid, 1 a violation, 2 bad input.
+// acyclic-check: checks a scenario's start stance, or a plan, against the
+// validity contract (DESIGN.md section 9) and prints every check with its
+// figures. Exit status: 0 valid, 1 a violation, 2 bad input.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <iostream>
 
-#include "planner/check/validity.h"
+#include "planner/check/plan_check.h"
 #include "planner/common/format_error.h"
 #include "planner/scene/scenario.h"
 
 namespace {
 
-int printReport(const acyclic::ValidityReport& r) {
+void printParts(const acyclic::ValidityReport& r, const char* indent) {
   for (const auto& p : r.parts) {
     const char* tag = !p.checked ? "skip" : p.ok() ? " ok " : "FAIL";
-    std::printf("  [%s] %-13s %s\n", tag, p.name.c_str(), p.summary.c_str());
-    for (const auto& v : p.violations) std::printf("         violation: %s\n", v.c_str());
+    std::printf("%s[%s] %-13s %s\n", indent, tag, p.name.c_str(), p.summary.c_str());
+    for (const auto& v : p.violations) std::printf("%s       violation: %s\n", indent, v.c_str());
   }
-  return r.valid() ? 0 : 1;
+}
+
+std::string describeStance(const acyclic::Scenario& sc, const std::vector<acyclic::ContactSpec>& s) {
+  std::string out;
+  for (const auto& c : s) out += (out.empty() ? "" : ", ") + sc.describe(c);
+  return out;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Checks a scenario's start stance against Acyclic's validity contract (DESIGN.md section 9):\n"
-      "joint limits, contacts, collisions, quasi-static equilibrium.\n"
+      "Checks a scenario's start stance, or a plan, against Acyclic's validity contract (DESIGN.md\n"
+      "section 9): joint limits, contacts, collisions and quasi-static equilibrium for every posture;\n"
+      "for a plan also the sequence (start stance first, goal met last, one contact change per step).\n"
       "Exit status: 0 valid, 1 a violation, 2 bad input."};
-  std::string scenario_path;
+  std::string scenario_path, plan_path;
+  bool verbose = false;
   app.add_option("scenario", scenario_path, "scenario file (format acyclic.scenario/1)")->required();
+  app.add_option("--plan", plan_path, "plan file (format acyclic.plan/1) to check against the scenario");
+  app.add_flag("-v,--verbose", verbose, "print every check of every stance, not only the failing ones");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -39,13 +47,35 @@ int main(int argc, char** argv) {
                 sc.robot->numJoints(), sc.robot->numLinks(), sc.robot->spots().size(), sc.robot->totalMass());
     std::printf("  scene %s: %zu obstacles, %zu contact surfaces\n", sc.scene->path().c_str(),
                 sc.scene->obstacles().size(), sc.scene->surfaces().size());
-    std::printf("start stance:");
-    for (const auto& c : sc.start_stance) std::printf(" %s", sc.describe(c).c_str());
-    std::printf("\n");
     acyclic::ValidityChecker checker(sc.robot, sc.scene);
-    const int status = printReport(checker.checkPosture(sc.start, sc.start_stance));
-    std::printf("%s\n", status == 0 ? "start stance: valid" : "start stance: INVALID");
-    return status;
+
+    if (plan_path.empty()) {
+      std::printf("start stance: %s\n", describeStance(sc, sc.start_stance).c_str());
+      const acyclic::ValidityReport r = checker.checkPosture(sc.start, sc.start_stance);
+      printParts(r, "  ");
+      std::printf("%s\n", r.valid() ? "start stance: valid" : "start stance: INVALID");
+      return r.valid() ? 0 : 1;
+    }
+
+    const acyclic::Plan plan = acyclic::readPlan(plan_path, sc);
+    std::printf("plan %s: %zu stances\n", plan_path.c_str(), plan.stances.size());
+    const acyclic::PlanReport rep = acyclic::checkPlan(plan, sc, checker);
+    int bad = 0;
+    for (std::size_t i = 0; i < rep.stances.size(); ++i) {
+      const bool ok = rep.stances[i].valid();
+      bad += !ok;
+      if (ok && !verbose) continue;
+      std::printf("  stance %zu: %s: %s\n", i, ok ? "valid" : "INVALID",
+                  describeStance(sc, plan.stances[i].specs()).c_str());
+      printParts(rep.stances[i], "    ");
+    }
+    std::printf("  [%s] postures      %zu of %zu stances valid (joint limits, contacts, collisions, equilibrium)\n",
+                bad ? "FAIL" : " ok ", rep.stances.size() - bad, rep.stances.size());
+    std::printf("  [%s] sequence      start stance first, goal met last, one contact change per step\n",
+                rep.sequence_violations.empty() ? " ok " : "FAIL");
+    for (const auto& v : rep.sequence_violations) std::printf("         violation: %s\n", v.c_str());
+    std::printf("%s\n", rep.valid() ? "plan: valid" : "plan: INVALID");
+    return rep.valid() ? 0 : 1;
   } catch (const acyclic::FormatError& e) {
     std::fprintf(stderr, "acyclic-check: %s\n", e.what());
     return 2;
