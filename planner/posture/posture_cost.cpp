@@ -22,4 +22,12 @@ double ReferencePostureCost::evaluate(const Kinematics& kin, Eigen::Ref<Eigen::V
   return wj_ * dj.squaredNorm() + wp_ * dp.squaredNorm() + wr_ * D.squaredNorm();
 }
 
+Eigen::VectorXd ReferencePostureCost::diagonalHessian(int n) const {
+  Eigen::VectorXd d(n);
+  d.segment<3>(0).setConstant(2 * wp_);
+  d.segment<3>(3).setConstant(4 * wr_);  // |R - Rr|^2 ~ 2 |w|^2 near the reference
+  d.tail(n - 6).setConstant(2 * wj_);
+  return d;
+}
+
 }  // namespace acyclic

@@ -13,6 +13,9 @@ class PostureCost {
   // The cost at the kinematics' configuration; adds its gradient (tangent
   // space, configuration.h) to grad.
   virtual double evaluate(const Kinematics& kin, Eigen::Ref<Eigen::VectorXd> grad) const = 0;
+  // A constant positive diagonal approximating the cost's Hessian in the
+  // tangent space (the solver's curvature when asked not to use L-BFGS).
+  virtual Eigen::VectorXd diagonalHessian(int tangent_size) const = 0;
 };
 
 // w_joint |q - r|^2 + w_position |p - p_r|^2 + w_rotation |R - R_r|_F^2.
@@ -21,6 +24,7 @@ class ReferencePostureCost : public PostureCost {
   explicit ReferencePostureCost(Configuration reference, double w_joint = 1.0, double w_position = 10.0,
                                 double w_rotation = 1.0);
   double evaluate(const Kinematics& kin, Eigen::Ref<Eigen::VectorXd> grad) const override;
+  Eigen::VectorXd diagonalHessian(int tangent_size) const override;
   const Configuration& reference() const { return ref_; }
 
  private:

@@ -1,6 +1,7 @@
 #include "planner/posture/posture_generator.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <set>
 
 #include <IpIpoptApplication.hpp>
@@ -26,14 +27,15 @@ namespace {
 // Ipopt's view of a PostureProblem.
 class PostureTNLP : public Ipopt::TNLP {
  public:
-  explicit PostureTNLP(PostureProblem& p, const Eigen::VectorXd& x0) : p_(p), x0_(x0) {}
+  PostureTNLP(PostureProblem& p, const Eigen::VectorXd& x0, bool diagonal_hessian)
+      : p_(p), x0_(x0), diagonal_(diagonal_hessian) {}
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
                     IndexStyleEnum& style) override {
     n = p_.numVariables();
     m = p_.numConstraints();
     nnz_jac = static_cast<Ipopt::Index>(p_.jacobianStructure().size());
-    nnz_h = 0;  // limited-memory quasi-Newton
+    nnz_h = diagonal_ ? n : 0;
     style = C_STYLE;
     return true;
   }
@@ -76,6 +78,17 @@ class PostureTNLP : public Ipopt::TNLP {
     p_.jacobianValues(map(n, x), values);
     return true;
   }
+  bool eval_h(Ipopt::Index n, const Ipopt::Number*, bool, Ipopt::Number obj_factor, Ipopt::Index,
+              const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols,
+              Ipopt::Number* values) override {
+    if (!values) {
+      for (Ipopt::Index i = 0; i < n; ++i) rows[i] = cols[i] = i;
+      return true;
+    }
+    if (hdiag_.size() != n) hdiag_ = p_.hessianDiagonal();
+    for (Ipopt::Index i = 0; i < n; ++i) values[i] = std::max(obj_factor, 1e-3) * hdiag_[i];
+    return true;
+  }
   bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number, Ipopt::Number,
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
                              Ipopt::Index, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
@@ -99,6 +112,8 @@ class PostureTNLP : public Ipopt::TNLP {
   static Eigen::VectorXd map(Ipopt::Index n, const Ipopt::Number* x) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
   PostureProblem& p_;
   Eigen::VectorXd x0_;
+  bool diagonal_;
+  Eigen::VectorXd hdiag_;
 };
 
 }  // namespace
@@ -118,7 +133,10 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   auto o = app->Options();
   o->SetStringValue("sb", "yes");  // no banner
   o->SetIntegerValue("print_level", opt_.print_level);
-  o->SetStringValue("hessian_approximation", "limited-memory");
+  if (opt_.print_level >= 4) o->SetStringValue("print_timing_statistics", "yes");
+  if (opt_.hessian != "diagonal" && opt_.hessian != "lbfgs")
+    throw std::invalid_argument("PostureGeneratorOptions::hessian: expected diagonal or lbfgs");
+  o->SetStringValue("hessian_approximation", opt_.hessian == "lbfgs" ? "limited-memory" : "exact");
   o->SetStringValue("mu_strategy", "adaptive");
   o->SetNumericValue("tol", opt_.tolerance);
   o->SetNumericValue("constr_viol_tol", opt_.tolerance);
@@ -128,13 +146,27 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   o->SetNumericValue("acceptable_constr_viol_tol", opt_.tolerance);
   o->SetNumericValue("acceptable_dual_inf_tol", 1e10);
   o->SetNumericValue("acceptable_compl_inf_tol", 1e-3);
-  o->SetNumericValue("acceptable_obj_change_tol", 1e-3);
-  o->SetIntegerValue("acceptable_iter", 3);
+  o->SetNumericValue("acceptable_obj_change_tol", 1e-2);
+  o->SetIntegerValue("acceptable_iter", 1);
   // Out-of-reach contacts are common in the search: enter the restoration
   // phase early, so that local infeasibility is found fast.
   o->SetStringValue("expect_infeasible_problem", "yes");
   o->SetIntegerValue("max_iter", opt_.max_iterations);
   o->SetNumericValue("max_cpu_time", opt_.max_seconds);
+  for (const auto& kv : opt_.ipopt_options) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("Ipopt option '" + kv + "': expected name=value");
+    const std::string name = kv.substr(0, eq), value = kv.substr(eq + 1);
+    char* end = nullptr;
+    const double num = std::strtod(value.c_str(), &end);
+    bool ok;
+    if (end && *end == '\0' && !value.empty())
+      ok = value.find_first_of(".eE") == std::string::npos ? o->SetIntegerValue(name, static_cast<int>(num))
+                                                          : o->SetNumericValue(name, num);
+    else
+      ok = o->SetStringValue(name, value);
+    if (!ok) throw std::invalid_argument("Ipopt refuses option '" + kv + "'");
+  }
   if (app->Initialize() != ::Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialize");
 }
 
@@ -157,7 +189,7 @@ PostureResult PostureGenerator::solve(const PostureRequest& request) {
 
   Eigen::VectorXd x0 = problem->initialPoint();
   for (int round = 0; round <= opt_.collision_rounds; ++round) {
-    ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0);
+    ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0, opt_.hessian == "diagonal");
     const double budget = opt_.max_seconds - elapsed();
     if (budget <= 0) {
       res.status = PostureResult::Status::TimeLimit;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "planner/posture/posture_problem.h"
 
@@ -14,10 +15,15 @@ namespace acyclic {
 struct PostureGeneratorOptions {
   PostureOptions problem;
   int max_iterations = 300;
-  double max_seconds = 0.5;           // CPU seconds per solve (Ipopt's max_cpu_time)
+  double max_seconds = 0.25;          // CPU seconds per solve (Ipopt's max_cpu_time)
   double tolerance = 1e-6;            // Ipopt's tol and constr_viol_tol
   int collision_rounds = 3;           // re-solves when a pair left out of the problem collides
+  // Curvature: "diagonal" (the cost's, constant: one factorization per
+  // iteration) or "lbfgs" (Ipopt's limited-memory quasi-Newton).
+  std::string hessian = "lbfgs";
   int print_level = 0;                // Ipopt's, for debugging
+  // Further Ipopt options "name=value", applied last (for tuning and debugging).
+  std::vector<std::string> ipopt_options;
 };
 
 struct PostureResult {

@@ -262,6 +262,14 @@ Eigen::VectorXd PostureProblem::initialPoint() const {
   return x;
 }
 
+Eigen::VectorXd PostureProblem::hessianDiagonal() const {
+  Eigen::VectorXd d = Eigen::VectorXd::Constant(nx_, 1e-6);
+  d.head(nq_) = req_.cost->diagonalHessian(nq_);
+  if (x_float_ >= 0) d.segment<3>(x_float_).setConstant(1e-3);
+  d.segment(x_lambda_, n_lambda_).setConstant(2 * opt_.force_regularization);
+  return d;
+}
+
 Configuration PostureProblem::configurationAt(const Eigen::VectorXd& x) const {
   const Configuration& q0 = req_.initial_guess;
   Configuration q = q0;

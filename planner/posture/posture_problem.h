@@ -84,6 +84,10 @@ class PostureProblem {
   const Eigen::MatrixXd& constraintJacobian(const Eigen::VectorXd& x);  // dense, rows x variables
   void jacobianValues(const Eigen::VectorXd& x, double* values);       // in structure order
 
+  // A constant positive diagonal approximating the Lagrangian's Hessian: the
+  // cost's curvature, the constraints' neglected.
+  Eigen::VectorXd hessianDiagonal() const;
+
   Configuration configurationAt(const Eigen::VectorXd& x) const;
   SurfacePlacement floatingAt(const Eigen::VectorXd& x) const;
   // World corner points and forces of each supporting contact.
