@@ -231,8 +231,9 @@ Eigen::VectorXd PostureProblem::initialPoint() const {
     const Eigen::Vector2d c = v.polygon.centroid();
     x[x_float_] = c.x();
     x[x_float_ + 1] = c.y();
-    // Start from the spot's current heading when the volume allows it.
-    x[x_float_ + 2] = std::clamp(0.0, v.theta_min, v.theta_max);
+    // Start at angle 0 (modulo 2 pi) when the interval holds it, else at its middle.
+    const double zero = v.theta_min + std::fmod(std::fmod(-v.theta_min, 2 * M_PI) + 2 * M_PI, 2 * M_PI);
+    x[x_float_ + 2] = zero <= v.theta_max ? zero : 0.5 * (v.theta_min + v.theta_max);
   }
   // Forces: the least-squares balance of the weight at the initial guess
   // (force and moment rows), kept non-negative.
