@@ -1,0 +1,416 @@
+#include "planner/search/contact_planner.h"
+
+#include <chrono>
+#include <deque>
+#include <cmath>
+#include <queue>
+#include <random>
+
+#include "planner/check/validity.h"
+#include "planner/search/guide_potential.h"
+
+namespace acyclic {
+
+const char* toString(PlanningResult::Status s) {
+  switch (s) {
+    case PlanningResult::Status::Solved: return "solved";
+    case PlanningResult::Status::NoSolution: return "no solution";
+    case PlanningResult::Status::NodeBudget: return "node budget exhausted";
+    case PlanningResult::Status::PostureBudget: return "posture-call budget exhausted";
+    case PlanningResult::Status::TimeLimit: return "time limit";
+    case PlanningResult::Status::Cancelled: return "cancelled";
+    case PlanningResult::Status::InvalidInput: return "invalid input";
+  }
+  return "?";
+}
+
+PlannerParameters::PlannerParameters() {
+  // An iteration bound, not a time bound, ends each posture call: the same
+  // scenario and seed give the same plan on any machine. The time limit is a
+  // safety net far above a normal call.
+  posture.max_iterations = 120;
+  posture.max_seconds = 2.0;
+}
+
+namespace {
+
+// Distance of a link coordinate to the goal interval, squared, plus a small
+// pull toward a reference posture (the parent's witness): the baseline
+// potential of the ablation "distance to goal instead of f_T".
+class GoalDistanceCost : public PostureCost {
+ public:
+  GoalDistanceCost(const GoalCondition& g, const Configuration& reference) : g_(g), ref_(reference, 0.01, 0.1, 0.01) {}
+  double evaluate(const Kinematics& kin, Eigen::Ref<Eigen::VectorXd> grad) const override {
+    double f = ref_.evaluate(kin, grad);
+    const Eigen::Vector3d p = kin.linkPose(g_.link).translation();
+    const double v = p[g_.axis];
+    const double d = v < g_.min ? v - g_.min : v > g_.max ? v - g_.max : 0.0;
+    if (d != 0) {
+      Eigen::Vector3d e = Eigen::Vector3d::Zero();
+      e[g_.axis] = 2 * d;
+      kin.addPointGradient(g_.link, p, e, grad);
+    }
+    return f + d * d;
+  }
+  Eigen::VectorXd diagonalHessian(int n) const override { return ref_.diagonalHessian(n); }
+
+ private:
+  GoalCondition g_;
+  ReferencePostureCost ref_;
+};
+
+}  // namespace
+
+struct ContactPlanner::Impl {
+  const Scenario& sc;
+  PlannerParameters p;
+  PostureGenerator pg;
+  ValidityChecker checker;
+  std::unique_ptr<GuidePotential> guide;
+  std::mt19937 rng;
+
+  enum class Change { Root, Added, Removed };
+  struct Node {
+    std::vector<ContactSpec> contacts;    // all supporting, for its sons
+    std::vector<ContactSpec> transition;  // the stance its witness stands for
+    Configuration q;
+    double key = 0;
+    int parent = -1;
+    Change change = Change::Root;
+    int generator = -1;                   // the pair generator that made it (lazy sons)
+  };
+  struct PairGenerator {
+    int node, spot, surface;
+    std::vector<std::pair<double, SearchVolume>> volumes;  // inherited key, volume
+    int samples_left = 0;
+  };
+  struct Entry {
+    double key;
+    long order;  // ties: first generated first (determinism)
+    int node;
+    bool operator<(const Entry& o) const { return key > o.key || (key == o.key && order > o.order); }
+  };
+
+  // deques: a son is added while references to its parent are held
+  std::deque<Node> nodes;
+  std::deque<PairGenerator> gens;
+  std::priority_queue<Entry> open;
+  PlanningStats stats;
+  std::chrono::steady_clock::time_point t0;
+  long order = 0;
+  int goal_node = -1;
+  PlanningResult::Status stop = PlanningResult::Status::NoSolution;
+  std::string stop_reason;
+
+  Impl(const Scenario& s, PlannerParameters params)
+      : sc(s), p(std::move(params)), pg(s.robot, s.scene, p.posture), checker(s.robot, s.scene), rng(s.seed) {
+    if (p.guide_potential) {
+      std::vector<Configuration> keys = sc.key_postures;
+      if (keys.size() < 2) throw std::invalid_argument("the guide potential needs key postures (at least two)");
+      guide = std::make_unique<GuidePotential>(keys, p.potential_k, p.smoothing_tolerance);
+    }
+  }
+
+  std::shared_ptr<const PostureCost> costFrom(const Configuration& parent) const {
+    if (guide) return std::shared_ptr<const PostureCost>(guide.get(), [](const PostureCost*) {});
+    return std::make_shared<GoalDistanceCost>(sc.goal, parent);
+  }
+  double keyOf(const Configuration& q) const {
+    Kinematics k(sc.robot);
+    k.setConfiguration(q);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(q.tangentSize());
+    if (guide) return guide->evaluate(k, g);
+    return GoalDistanceCost(sc.goal, q).evaluate(k, g);
+  }
+  double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
+
+  bool budgetLeft() {
+    if (stats.nodes_generated >= p.max_nodes) {
+      stop = PlanningResult::Status::NodeBudget;
+      stop_reason = std::to_string(p.max_nodes) + " nodes generated without reaching the goal";
+      return false;
+    }
+    if (stats.posture_calls >= p.max_posture_calls) {
+      stop = PlanningResult::Status::PostureBudget;
+      stop_reason = std::to_string(p.max_posture_calls) + " posture calls without reaching the goal";
+      return false;
+    }
+    if (elapsed() > p.max_seconds) {
+      stop = PlanningResult::Status::TimeLimit;
+      stop_reason = "no plan within " + std::to_string(p.max_seconds) + " s";
+      return false;
+    }
+    return true;
+  }
+
+  PostureResult solve(const PostureRequest& r) {
+    ++stats.posture_calls;
+    PostureResult res = pg.solve(r);
+    if (!res.success()) ++stats.posture_failures;
+    return res;
+  }
+
+  static bool sameContacts(const std::vector<ContactSpec>& a, const std::vector<ContactSpec>& b, double dist,
+                           double angle) {
+    if (a.size() != b.size()) return false;
+    for (const auto& ca : a) {
+      bool found = false;
+      for (const auto& cb : b)
+        found = found || (ca.spot == cb.spot && ca.surface == cb.surface &&
+                          std::hypot(ca.placement.x - cb.placement.x, ca.placement.y - cb.placement.y) <= dist &&
+                          std::abs(std::remainder(ca.placement.theta - cb.placement.theta, 2 * M_PI)) <= angle);
+      if (!found) return false;
+    }
+    return true;
+  }
+
+  // Adds a son if its witness passes the independent check and no node is too
+  // close to it; returns its index or -1.
+  int addNode(Node n) {
+    ++stats.nodes_generated;
+    for (const auto& m : nodes)
+      if (sameContacts(m.contacts, n.contacts, p.duplicate_distance, p.duplicate_angle)) return -1;
+    if (!checker.checkPosture(n.q, n.transition).valid()) {
+      ++stats.check_refusals;
+      return -1;
+    }
+    n.key = keyOf(n.q);
+    nodes.push_back(std::move(n));
+    const int id = static_cast<int>(nodes.size()) - 1;
+    Kinematics k(sc.robot);
+    k.setConfiguration(nodes[id].q);
+    if (sc.goal.satisfied(k) && goal_node < 0) goal_node = id;
+    open.push({nodes[id].key, order++, id});
+    if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) stats.best_potential = nodes[id].key;
+    return id;
+  }
+
+  void removalSons(int ni) {
+    const Node& n = nodes[ni];
+    if (n.contacts.size() < 2) return;
+    for (std::size_t c = 0; c < n.contacts.size() && budgetLeft() && goal_node < 0; ++c) {
+      PostureRequest r;
+      r.contacts = nodes[ni].contacts;
+      r.contacts[c].supporting = false;
+      r.initial_guess = nodes[ni].q;
+      r.cost = costFrom(nodes[ni].q);
+      const PostureResult res = solve(r);
+      if (!res.success()) continue;
+      Node son;
+      son.transition = r.contacts;
+      son.contacts = nodes[ni].contacts;
+      son.contacts.erase(son.contacts.begin() + c);
+      son.q = res.configuration;
+      son.parent = ni;
+      son.change = Change::Removed;
+      addNode(son);
+    }
+  }
+
+  // The next son of a pair generator, or -1 when it has none left.
+  int nextSon(int gi) {
+    while (budgetLeft() && goal_node < 0) {
+      PairGenerator& g = gens[gi];
+      const Node& n = nodes[g.node];
+      PostureRequest r;
+      r.contacts = n.contacts;
+      r.initial_guess = n.q;
+      r.cost = costFrom(n.q);
+      ContactSpec added;
+      added.spot = g.spot;
+      added.surface = g.surface;
+      added.supporting = false;
+      SearchVolume volume;
+      if (p.optimized_candidates) {
+        if (g.volumes.empty()) return -1;
+        // the volume whose parent candidate was best, first
+        std::size_t best = 0;
+        for (std::size_t k = 1; k < g.volumes.size(); ++k)
+          if (g.volumes[k].first < g.volumes[best].first) best = k;
+        volume = g.volumes[best].second;
+        g.volumes.erase(g.volumes.begin() + best);
+        FloatingContact f;
+        f.spot = g.spot;
+        f.surface = g.surface;
+        f.volume = volume;
+        r.floating = f;
+      } else {
+        if (g.samples_left-- <= 0) return -1;
+        // the paper's earlier method: a random placement on the surface
+        const Surface& s = sc.scene->surfaces()[g.surface];
+        Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+        for (const auto& v : s.polygon.vertices()) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+        std::uniform_real_distribution<double> u(0, 1);
+        do {
+          added.placement.x = lo.x() + (hi.x() - lo.x()) * u(rng);
+          added.placement.y = lo.y() + (hi.y() - lo.y()) * u(rng);
+        } while (!s.polygon.contains({added.placement.x, added.placement.y}));
+        added.placement.theta = -M_PI + 2 * M_PI * u(rng);
+        r.contacts.push_back(added);
+      }
+      const PostureResult res = solve(r);
+      if (!res.success()) continue;  // that volume (or sample) holds no feasible contact
+      if (p.optimized_candidates) added.placement = res.floating;
+      Node son;
+      son.transition = nodes[g.node].contacts;
+      son.transition.push_back(added);
+      son.contacts = son.transition;
+      son.contacts.back().supporting = true;
+      son.q = res.configuration;
+      son.parent = g.node;
+      son.change = Change::Added;
+      son.generator = gi;
+      const double parent_key = keyOf(res.configuration);
+      if (p.optimized_candidates)
+        for (auto& part : subtractBox(volume, res.floating, p.box)) gens[gi].volumes.push_back({parent_key, part});
+      const int id = addNode(son);
+      if (id >= 0) return id;
+    }
+    return -1;
+  }
+
+  void expand(int ni) {
+    ++stats.nodes_expanded;
+    removalSons(ni);
+    if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return;
+    for (int spot : sc.allowed_spots) {
+      bool used = false;
+      for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
+      if (used) continue;
+      for (int surface : sc.allowed_surfaces) {
+        if (!budgetLeft() || goal_node >= 0) return;
+        PairGenerator g;
+        g.node = ni;
+        g.spot = spot;
+        g.surface = surface;
+        g.volumes.push_back({0.0, fullVolume(sc.scene->surfaces()[surface].polygon)});
+        g.samples_left = p.random_samples_per_pair;
+        gens.push_back(g);
+        const int gi = static_cast<int>(gens.size()) - 1;
+        const int sons = p.lazy_sons ? 1 : (p.optimized_candidates ? p.eager_candidates_per_pair : p.random_samples_per_pair);
+        for (int k = 0; k < sons; ++k)
+          if (nextSon(gi) < 0) break;
+      }
+    }
+  }
+
+  // The plan along the path to `last`: each node's transition stance, with a
+  // stance between two of them where the earlier change settles (an added
+  // contact starts to support, a removed one is gone), so that consecutive
+  // stances differ by one contact (DESIGN.md section 8).
+  Plan exportPlan(int last) {
+    std::vector<int> path;
+    for (int n = last; n >= 0; n = nodes[n].parent) path.insert(path.begin(), n);
+    Plan plan;
+    plan.scenario = sc.path;
+    plan.robot = sc.robot->descriptionPath();
+    auto push = [&](const std::vector<ContactSpec>& specs, const Configuration& q) {
+      PlanStance st;
+      st.configuration = q;
+      st.potential = keyOf(q);
+      QuasiStaticReport eq;
+      checker.checkPosture(q, specs);
+      checker.checkEquilibrium(specs, &eq);
+      for (std::size_t i = 0; i < specs.size(); ++i) {
+        PlanContact c;
+        c.spec = specs[i];
+        c.frame = contactFrame(sc.scene->surfaces()[specs[i].surface], specs[i].placement);
+        if (specs[i].supporting && i < eq.points.size()) c.points = eq.points[i], c.forces = eq.forces[i];
+        st.contacts.push_back(c);
+      }
+      plan.stances.push_back(st);
+    };
+    push(nodes[path[0]].transition, nodes[path[0]].q);
+    for (std::size_t i = 1; i < path.size(); ++i) {
+      const Node& prev = nodes[path[i - 1]];
+      const Node& cur = nodes[path[i]];
+      if (i >= 2) {
+        // The settled stance prev.contacts: its witness touches exactly its contacts.
+        if (prev.change == Change::Added) {
+          push(prev.contacts, prev.q);
+        } else if (cur.change == Change::Removed) {
+          push(prev.contacts, cur.q);
+        } else {
+          PostureRequest r;
+          r.contacts = prev.contacts;
+          r.initial_guess = cur.q;
+          r.cost = costFrom(cur.q);
+          PostureResult res = solve(r);
+          if (!res.success()) {
+            r.initial_guess = prev.q;
+            res = solve(r);
+          }
+          push(prev.contacts, res.success() ? res.configuration : prev.q);
+        }
+      }
+      push(cur.transition, cur.q);
+    }
+    plan.stats.nodes_generated = stats.nodes_generated;
+    plan.stats.nodes_expanded = stats.nodes_expanded;
+    plan.stats.posture_calls = stats.posture_calls;
+    plan.stats.posture_failures = stats.posture_failures;
+    plan.stats.seconds = elapsed();
+    return plan;
+  }
+};
+
+ContactPlanner::ContactPlanner(const Scenario& scenario, PlannerParameters params)
+    : impl_(std::make_unique<Impl>(scenario, std::move(params))) {}
+ContactPlanner::~ContactPlanner() = default;
+
+PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progress& progress) {
+  Impl& I = *impl_;
+  I.t0 = std::chrono::steady_clock::now();
+  PlanningResult out;
+  Impl::Node root;
+  root.contacts = I.sc.start_stance;
+  root.transition = I.sc.start_stance;
+  root.q = I.sc.start;
+  const ValidityReport rep = I.checker.checkPosture(root.q, root.contacts);
+  if (!rep.valid()) {
+    out.status = PlanningResult::Status::InvalidInput;
+    for (const auto& part : rep.parts)
+      if (!part.ok()) out.reason = "the start stance is not valid: " + part.name + ": " + part.violations[0];
+    return out;
+  }
+  I.addNode(root);
+  double last_report = -1;
+  while (I.goal_node < 0) {
+    if (cancel && cancel->load()) {
+      I.stop = PlanningResult::Status::Cancelled;
+      I.stop_reason = "cancelled";
+      break;
+    }
+    if (!I.budgetLeft()) break;
+    if (I.open.empty()) {
+      I.stop = PlanningResult::Status::NoSolution;
+      I.stop_reason = "every stance reachable from the start was explored";
+      break;
+    }
+    const Impl::Entry e = I.open.top();
+    I.open.pop();
+    const int gen = I.nodes[e.node].generator;
+    I.expand(e.node);
+    if (gen >= 0 && I.p.lazy_sons) I.nextSon(gen);  // its pair's next son, now that this one is taken
+    I.stats.seconds = I.elapsed();
+    if (progress && I.stats.seconds - last_report >= 0.5) {
+      progress(I.stats);
+      last_report = I.stats.seconds;
+    }
+  }
+  I.stats.seconds = I.elapsed();
+  out.stats = I.stats;
+  if (I.goal_node >= 0) {
+    out.status = PlanningResult::Status::Solved;
+    out.plan = I.exportPlan(I.goal_node);
+    out.stats = I.stats;
+    out.plan.stats.seconds = out.stats.seconds = I.elapsed();
+  } else {
+    out.status = I.stop;
+    out.reason = I.stop_reason;
+  }
+  if (progress) progress(out.stats);
+  return out;
+}
+
+}  // namespace acyclic

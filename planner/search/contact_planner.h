@@ -1,0 +1,77 @@
+#pragma once
+// The contact planner (paper, 2.2-2.8): best-first search over sets of
+// contacts, keyed on the guide potential f_T of each node's witness posture.
+//
+// A node is a set of contacts and the witness posture found when it was
+// created: the transition posture, in which the contact just added or just
+// removed touches but does not support (paper, 2.3). Its sons:
+//   - removal of each of its contacts (generated eagerly): the posture
+//     generator with that contact geometric only;
+//   - addition, for each pair (spot R, surface E): candidates from the
+//     posture generator with the new contact floating in a search volume
+//     (2.5-2.6). With lazy sons (2.8) a pair keeps one pending son at a time,
+//     and its next son is generated only when that one is selected.
+// Every witness is re-checked by the independent validity check before its
+// node joins the tree. Ablation switches reproduce the paper's baseline:
+// random (x, y, theta) samples instead of optimized candidates, eager
+// instead of lazy sons, distance to the goal instead of f_T.
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "planner/plan/plan.h"
+#include "planner/posture/posture_generator.h"
+#include "planner/search/search_volume.h"
+
+namespace acyclic {
+
+struct PlannerParameters {
+  double potential_k = 1.0;            // slope of f_T along the guide
+  double smoothing_tolerance = 0.05;   // corner blends of the guide
+  BoxHalfSizes box;                    // subtracted around each candidate
+  double duplicate_distance = 0.05;    // m: sons this close to a node (same contacts) are dropped
+  double duplicate_angle = 0.35;       // rad
+  int max_contacts = 6;                // no stance with more contacts
+  long max_nodes = 1000;               // nodes generated
+  long max_posture_calls = 20000;
+  double max_seconds = 60;
+  bool lazy_sons = true;               // paper 2.8 (false: every son of a node at once)
+  bool optimized_candidates = true;    // paper 2.6 (false: random samples per pair)
+  int random_samples_per_pair = 4;     // with optimized_candidates = false
+  int eager_candidates_per_pair = 6;   // with lazy_sons = false: candidates per pair at expansion
+  bool guide_potential = true;         // paper 2.7 (false: distance to the goal)
+  PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
+  PlannerParameters();
+};
+
+struct PlanningStats {
+  long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
+  double seconds = 0, best_potential = 0;
+};
+
+struct PlanningResult {
+  enum class Status { Solved, NoSolution, NodeBudget, PostureBudget, TimeLimit, Cancelled, InvalidInput };
+  Status status = Status::InvalidInput;
+  std::string reason;
+  Plan plan;            // the path to the goal (Solved), else empty
+  PlanningStats stats;
+  bool solved() const { return status == Status::Solved; }
+};
+
+const char* toString(PlanningResult::Status s);
+
+class ContactPlanner {
+ public:
+  using Progress = std::function<void(const PlanningStats&)>;
+  ContactPlanner(const Scenario& scenario, PlannerParameters params = {});
+  ~ContactPlanner();
+  // Plans; `cancel` (set from another thread) stops the search with Cancelled.
+  PlanningResult plan(const std::atomic<bool>* cancel = nullptr, const Progress& progress = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace acyclic
