@@ -99,6 +99,7 @@ struct ContactPlanner::Impl {
   std::chrono::steady_clock::time_point t0;
   long order = 0;
   int goal_node = -1;
+  const std::atomic<bool>* cancel = nullptr;  // checked before every posture call
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
 
@@ -125,6 +126,11 @@ struct ContactPlanner::Impl {
   double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
   bool budgetLeft() {
+    if (cancel && cancel->load()) {
+      stop = PlanningResult::Status::Cancelled;
+      stop_reason = "cancelled";
+      return false;
+    }
     if (stats.nodes_generated >= p.max_nodes) {
       stop = PlanningResult::Status::NodeBudget;
       stop_reason = std::to_string(p.max_nodes) + " nodes generated without reaching the goal";
@@ -361,6 +367,7 @@ ContactPlanner::~ContactPlanner() = default;
 PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progress& progress) {
   Impl& I = *impl_;
   I.t0 = std::chrono::steady_clock::now();
+  I.cancel = cancel;
   PlanningResult out;
   Impl::Node root;
   root.contacts = I.sc.start_stance;
@@ -376,11 +383,6 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   I.addNode(root);
   double last_report = -1;
   while (I.goal_node < 0) {
-    if (cancel && cancel->load()) {
-      I.stop = PlanningResult::Status::Cancelled;
-      I.stop_reason = "cancelled";
-      break;
-    }
     if (!I.budgetLeft()) break;
     if (I.open.empty()) {
       I.stop = PlanningResult::Status::NoSolution;
