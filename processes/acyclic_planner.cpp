@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "planner/common/format_error.h"
-#include "planner/search/contact_planner.h"
+#include "planner/search/planner_parameters.h"
 
 namespace {
 std::atomic<bool> g_cancel{false};
@@ -21,29 +21,34 @@ int main(int argc, char** argv) {
                "Exit status: 0 solved, 1 not solved (reason printed), 2 bad input."};
   std::string in, out;
   long seed = -1;
-  acyclic::PlannerParameters p;
+  double max_seconds = -1;
+  long max_nodes = -1, max_calls = -1;
   bool eager = false, random_candidates = false, goal_distance = false, quiet = false;
   app.add_option("--in", in, "scenario file (acyclic.scenario/1)")->required();
   app.add_option("--out", out, "plan file to write (acyclic.plan/1)")->required();
   app.add_option("--seed", seed, "overrides the scenario's seed");
-  app.add_option("--max-seconds", p.max_seconds, "wall-time budget")->capture_default_str();
-  app.add_option("--max-nodes", p.max_nodes, "nodes generated at most")->capture_default_str();
-  app.add_option("--max-posture-calls", p.max_posture_calls, "posture-generator calls at most")->capture_default_str();
+  app.add_option("--max-seconds", max_seconds, "wall-time budget (default: the scenario's planner section, else 60)");
+  app.add_option("--max-nodes", max_nodes, "nodes generated at most (default: scenario, else 1000)");
+  app.add_option("--max-posture-calls", max_calls, "posture-generator calls at most (default: scenario, else 20000)");
   app.add_flag("--eager-sons", eager, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
   app.add_flag("--random-candidates", random_candidates,
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");
   app.add_flag("--distance-to-goal", goal_distance, "ablation: distance to the goal instead of the guide potential");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   CLI11_PARSE(app, argc, argv);
-  p.lazy_sons = !eager;
-  p.optimized_candidates = !random_candidates;
-  p.guide_potential = !goal_distance;
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   try {
     acyclic::Scenario sc = acyclic::Scenario::load(in);
     if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
+    acyclic::PlannerParameters p = acyclic::plannerParameters(sc);
+    if (max_seconds > 0) p.max_seconds = max_seconds;
+    if (max_nodes > 0) p.max_nodes = max_nodes;
+    if (max_calls > 0) p.max_posture_calls = max_calls;
+    p.lazy_sons = !eager;
+    p.optimized_candidates = !random_candidates;
+    p.guide_potential = !goal_distance;
     acyclic::ContactPlanner planner(sc, p);
     const bool tty = !quiet && isatty(STDERR_FILENO);
     auto progress = [&](const acyclic::PlanningStats& s) {

@@ -5,7 +5,8 @@
 #include <thread>
 
 #include "planner/check/plan_check.h"
-#include "planner/search/contact_planner.h"
+#include "planner/common/format_error.h"
+#include "planner/search/planner_parameters.h"
 #include "test_support.h"
 
 using namespace acyclic;
@@ -111,6 +112,33 @@ TEST(ContactPlanner, AblationsStillPlanValidly) {
       // the random baseline may fail to find a plan, but says why
       EXPECT_EQ(which, 1) << toString(r.status) << ": " << r.reason;
       EXPECT_FALSE(r.reason.empty());
+    }
+  }
+}
+
+TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
+  test::TempDir dir;
+  std::string text = test::readFile(test::sourcePath("models/scenarios/step_forward.yaml"));
+  const std::string root = test::sourcePath("models/");
+  text.replace(text.find("../hrp2/"), 8, root + "hrp2/");
+  text.replace(text.find("../scenes/"), 10, root + "scenes/");
+  const Scenario plain = Scenario::load(dir.write("a.yaml", text));
+  EXPECT_EQ(plannerParameters(plain).max_nodes, PlannerParameters().max_nodes);
+  const Scenario tuned =
+      Scenario::load(dir.write("b.yaml", text + "planner: {max_nodes: 77, box_half_sizes: [0.1, 0.2, 0.3]}\n"));
+  const PlannerParameters p = plannerParameters(tuned);
+  EXPECT_EQ(p.max_nodes, 77);
+  EXPECT_DOUBLE_EQ(p.box.y, 0.2);
+  for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
+           {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
+           {"planner: {max_node: 5}\n", "planner.max_node"},
+           {"planner: {box_half_sizes: [0.1, -1, 0.3]}\n", "planner.box_half_sizes"}}) {
+    const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
+    try {
+      plannerParameters(sc);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const FormatError& e) {
+      EXPECT_EQ(e.field(), field) << e.what();
     }
   }
 }

@@ -42,7 +42,7 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   YamlField root = YamlField::loadText(text, origin);
   root.requireFormat("acyclic.scenario/1");
   root.allowOnly({"format", "name", "robot", "scene", "seed", "start", "allowed_spots", "allowed_surfaces",
-                  "goal", "key_postures"});
+                  "goal", "key_postures", "planner"});
   Scenario sc;
   sc.path = origin;
   sc.name = root.has("name") ? root["name"].string() : fs::path(origin).stem().string();
@@ -130,6 +130,10 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
     YamlField kp = root["key_postures"];
     for (std::size_t i = 0; i < kp.size(); ++i) sc.key_postures.push_back(sc.robot->readConfiguration(kp.at(i)));
     if (sc.key_postures.size() == 1) kp.fail("at least two key postures (a start and an end)");
+  }
+  if (root.has("planner")) {
+    if (!root["planner"].isMap()) root["planner"].fail("a map of planner parameters");
+    sc.planner_section = root["planner"];
   }
   return sc;
 }

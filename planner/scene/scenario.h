@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "planner/common/yaml_field.h"
 #include "planner/model/robot_model.h"
 #include "planner/scene/scene.h"
 
@@ -45,6 +47,9 @@ struct Scenario {
   GoalCondition goal;
   std::vector<Configuration> key_postures;
   std::uint64_t seed = 1;
+  // The optional `planner:` section, read and validated by the planner
+  // (planner/search/planner_parameters.h); absent: the planner's defaults.
+  std::optional<YamlField> planner_section;
 
   // Loads a scenario file; robot and scene paths resolve against its folder.
   static Scenario load(const std::string& path);

@@ -1,0 +1,42 @@
+#include "planner/search/planner_parameters.h"
+
+namespace acyclic {
+
+PlannerParameters plannerParameters(const Scenario& sc) {
+  PlannerParameters p;
+  if (!sc.planner_section) return p;
+  const YamlField& f = *sc.planner_section;
+  f.allowOnly({"potential_k", "smoothing_tolerance", "box_half_sizes", "duplicate_distance", "duplicate_angle",
+               "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations",
+               "collision_margin"});
+  auto positive = [&](const char* key, double& out) {
+    if (!f.has(key)) return;
+    const double v = f[key].number();
+    if (!(v > 0)) f[key].fail("a positive number");
+    out = v;
+  };
+  auto count = [&](const char* key, auto& out) {
+    if (!f.has(key)) return;
+    const int v = f[key].integer();
+    if (v < 1) f[key].fail("a positive integer");
+    out = v;
+  };
+  positive("potential_k", p.potential_k);
+  positive("smoothing_tolerance", p.smoothing_tolerance);
+  positive("duplicate_distance", p.duplicate_distance);
+  positive("duplicate_angle", p.duplicate_angle);
+  positive("max_seconds", p.max_seconds);
+  positive("collision_margin", p.posture.problem.collision_margin);
+  count("max_contacts", p.max_contacts);
+  count("max_nodes", p.max_nodes);
+  count("max_posture_calls", p.max_posture_calls);
+  count("posture_iterations", p.posture.max_iterations);
+  if (f.has("box_half_sizes")) {
+    const Eigen::Vector3d b = f["box_half_sizes"].vec3();
+    if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
+    p.box = {b.x(), b.y(), b.z()};
+  }
+  return p;
+}
+
+}  // namespace acyclic
