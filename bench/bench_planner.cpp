@@ -1,0 +1,44 @@
+// The contact planner with each of the paper's ideas switched off in turn,
+// side by side in one run: wall time, nodes, posture calls and failures, plan
+// length. Usage: bench_planner [SCENARIO] [--max-seconds T]
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "planner/search/planner_parameters.h"
+
+using namespace acyclic;
+
+int main(int argc, char** argv) {
+  std::string path = ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml";
+  double max_seconds = -1;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
+    else path = argv[i];
+  }
+  const Scenario sc = Scenario::load(path);
+  struct Variant {
+    const char* name;
+    bool lazy, optimized, guide;
+  };
+  const Variant variants[] = {{"full planner (lazy sons, optimized candidates, f_T)", true, true, true},
+                              {"eager sons", false, true, true},
+                              {"random candidates", true, false, true},
+                              {"distance to goal instead of f_T", true, true, false}};
+  std::printf("scenario %s, budget per run: %s\n", sc.name.c_str(),
+              max_seconds > 0 ? (std::to_string(max_seconds) + " s").c_str() : "the scenario's");
+  std::printf("%-52s %-22s %9s %7s %9s %9s %8s\n", "variant", "result", "seconds", "nodes", "calls", "failed",
+              "stances");
+  for (const auto& v : variants) {
+    PlannerParameters p = plannerParameters(sc);
+    if (max_seconds > 0) p.max_seconds = max_seconds;
+    p.lazy_sons = v.lazy;
+    p.optimized_candidates = v.optimized;
+    p.guide_potential = v.guide;
+    const PlanningResult r = ContactPlanner(sc, p).plan();
+    std::printf("%-52s %-22s %9.2f %7ld %9ld %9ld %8zu\n", v.name, toString(r.status), r.stats.seconds,
+                r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures, r.plan.stances.size());
+    std::fflush(stdout);
+  }
+  return 0;
+}
