@@ -28,7 +28,7 @@ PlannerParameters::PlannerParameters() {
   // An iteration bound, not a time bound, ends each posture call: the same
   // scenario and seed give the same plan on any machine. The time limit is a
   // safety net far above a normal call.
-  posture.max_iterations = 120;
+  posture.max_iterations = 60;  // successes need 15-35 (bench_posture); failures stop early
   posture.max_seconds = 2.0;
 }
 
@@ -170,12 +170,44 @@ struct ContactPlanner::Impl {
     return true;
   }
 
+  bool isDuplicate(const std::vector<ContactSpec>& contacts) const {
+    for (const auto& m : nodes)
+      if (sameContacts(m.contacts, contacts, p.duplicate_distance, p.duplicate_angle)) return true;
+    return false;
+  }
+
+  // Whether a spot can reach a surface from a posture: the distance from its
+  // limb's root joint to the surface polygon is within the limb's length plus
+  // a slack for the trunk and base. Conservative: it only skips pairs that no
+  // posture near this one could realize.
+  bool reachable(int spot, int surface, const Kinematics& k) const {
+    const RobotModel& m = *sc.robot;
+    const ContactSpot& s = m.spots()[spot];
+    const std::vector<int>& chain = m.ancestorJoints(s.link);
+    // the limb's root: the first joint below the trunk (waist, chest)
+    int root = -1;
+    for (int j : chain) {
+      const std::string& parent = m.links()[m.joints()[j].parent_link].name;
+      if (parent == "WAIST" || parent.rfind("CHEST", 0) == 0) root = j;
+    }
+    if (root < 0) return true;
+    // the limb's length: the rigid offsets from joint to joint below the root, then to the spot
+    double reach = s.frame.translation().norm();
+    for (std::size_t i = 1; i < chain.size(); ++i)
+      if (m.jointMovesLink(root, m.joints()[chain[i]].child_link) && chain[i] != root)
+        reach += (k.jointOrigin(chain[i]) - k.jointOrigin(chain[i - 1])).norm();
+    const Surface& surf = sc.scene->surfaces()[surface];
+    const Eigen::Vector3d o = surf.frame.inverse() * k.jointOrigin(root);
+    const double in_plane = std::max(0.0, surf.polygon.signedDistance(o.head<2>()));
+    const double distance = std::hypot(in_plane, o.z());
+    return distance <= reach + p.reach_slack;
+  }
+
   // Adds a son if its witness passes the independent check and no node is too
   // close to it; returns its index or -1.
   int addNode(Node n) {
     ++stats.nodes_generated;
-    for (const auto& m : nodes)
-      if (sameContacts(m.contacts, n.contacts, p.duplicate_distance, p.duplicate_angle)) return -1;
+    if (isDuplicate(n.contacts)) return -1;
     if (!checker.checkPosture(n.q, n.transition).valid()) {
       ++stats.check_refusals;
       return -1;
@@ -194,7 +226,10 @@ struct ContactPlanner::Impl {
   void removalSons(int ni) {
     const Node& n = nodes[ni];
     if (n.contacts.size() < 2) return;
-    for (std::size_t c = 0; c < n.contacts.size() && budgetLeft() && goal_node < 0; ++c) {
+    for (std::size_t c = 0; c < nodes[ni].contacts.size() && budgetLeft() && goal_node < 0; ++c) {
+      std::vector<ContactSpec> rest = nodes[ni].contacts;
+      rest.erase(rest.begin() + c);
+      if (isDuplicate(rest)) continue;  // known before any posture call
       PostureRequest r;
       r.contacts = nodes[ni].contacts;
       r.contacts[c].supporting = false;
@@ -279,12 +314,15 @@ struct ContactPlanner::Impl {
     ++stats.nodes_expanded;
     removalSons(ni);
     if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return;
+    Kinematics parent_kin(sc.robot);
+    parent_kin.setConfiguration(nodes[ni].q);
     for (int spot : sc.allowed_spots) {
       bool used = false;
       for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
       if (used) continue;
       for (int surface : sc.allowed_surfaces) {
         if (!budgetLeft() || goal_node >= 0) return;
+        if (!reachable(spot, surface, parent_kin)) continue;
         PairGenerator g;
         g.node = ni;
         g.spot = spot;

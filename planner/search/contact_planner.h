@@ -33,6 +33,7 @@ struct PlannerParameters {
   double duplicate_distance = 0.05;    // m: sons this close to a node (same contacts) are dropped
   double duplicate_angle = 0.35;       // rad
   int max_contacts = 6;                // no stance with more contacts
+  double reach_slack = 0.3;            // m: trunk and base motion allowed for in the reachability test
   long max_nodes = 1000;               // nodes generated
   long max_posture_calls = 20000;
   double max_seconds = 60;
