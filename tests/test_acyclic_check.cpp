@@ -1,33 +1,18 @@
 // acyclic-check as a user runs it: exit status and what it prints.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
-#include <sys/wait.h>
-
 #include "test_support.h"
 
 namespace {
 
-struct CheckRun {
-  int status;
-  std::string output;
-};
-
-CheckRun run(const std::string& args) {
-  const std::string cmd = acyclic::test::binaryPath("processes/acyclic-check") + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+acyclic::test::ProcessRun run(const std::string& args) {
+  return acyclic::test::runProcess(acyclic::test::binaryPath("processes/acyclic-check") + " " + args);
 }
 
 }  // namespace
 
 TEST(AcyclicCheck, ChairStartStanceIsValid) {
-  const CheckRun r = run(acyclic::test::sourcePath("models/scenarios/chair_table.yaml"));
+  const acyclic::test::ProcessRun r = run(acyclic::test::sourcePath("models/scenarios/chair_table.yaml"));
   EXPECT_EQ(r.status, 0) << r.output;
   for (const char* part : {"joint limits", "contacts", "collisions", "equilibrium", "[ ok ] equilibrium"})
     EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
@@ -36,15 +21,12 @@ TEST(AcyclicCheck, ChairStartStanceIsValid) {
 
 TEST(AcyclicCheck, ViolationsArePrintedWithFiguresAndFail) {
   acyclic::test::TempDir dir;
-  std::string text = acyclic::test::readFile(acyclic::test::sourcePath("models/scenarios/chair_table.yaml"));
-  const std::string root = acyclic::test::sourcePath("models/");
-  text.replace(text.find("../hrp2/"), 8, root + "hrp2/");
-  text.replace(text.find("../scenes/"), 10, root + "scenes/");
+  std::string text = acyclic::test::scenarioText("models/scenarios/chair_table.yaml");
   // Knee beyond its limit, and the robot sunk 5 cm into the seat.
   text.replace(text.find("configuration: {posture: sitting, base_position: [0, 0, 0.405]}"), 64,
                "configuration: {posture: sitting, base_position: [0, 0, 0.355], joints_deg: {RLEG_JOINT3: 155}}\n"
                "  contacts:\n    - {spot: r_sole, surface: floor, x: 0.3, y: -0.095}\n#");
-  const CheckRun r = run(dir.write("bad.yaml", text));
+  const acyclic::test::ProcessRun r = run(dir.write("bad.yaml", text));
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_NE(r.output.find("RLEG_JOINT3"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("penetration"), std::string::npos) << r.output;
@@ -52,10 +34,10 @@ TEST(AcyclicCheck, ViolationsArePrintedWithFiguresAndFail) {
 }
 
 TEST(AcyclicCheck, BadInputNamesTheFileAndExitsTwo) {
-  const CheckRun missing = run("/nonexistent/scenario.yaml");
+  const acyclic::test::ProcessRun missing = run("/nonexistent/scenario.yaml");
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.output.find("/nonexistent/scenario.yaml"), std::string::npos) << missing.output;
-  const CheckRun help = run("--help");
+  const acyclic::test::ProcessRun help = run("--help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.output.find("validity contract"), std::string::npos) << help.output;
 }

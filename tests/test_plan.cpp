@@ -1,10 +1,6 @@
 // Plans: acyclic.plan/1 round trip, the plan check, and acyclic-check --plan.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
-#include <sys/wait.h>
-
 #include "planner/check/plan_check.h"
 #include "planner/common/format_error.h"
 #include "planner/posture/posture_generator.h"
@@ -78,19 +74,8 @@ const Plan& threeStancePlan() {
   return plan;
 }
 
-struct CheckRun {
-  int status;
-  std::string output;
-};
-
-CheckRun runCheck(const std::string& args) {
-  const std::string cmd = test::binaryPath("processes/acyclic-check") + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+test::ProcessRun runCheck(const std::string& args) {
+  return test::runProcess(test::binaryPath("processes/acyclic-check") + " " + args);
 }
 
 }  // namespace
@@ -181,23 +166,20 @@ TEST(AcyclicCheckPlan, ChecksEveryStanceAndTheSequence) {
   const std::string plan = dir.path() + "/plan.json";
   writePlan(threeStancePlan(), sc, plan);
   const std::string scenario = test::sourcePath("models/scenarios/chair_table.yaml");
-  const CheckRun r = runCheck(scenario + " --plan " + plan);
+  const test::ProcessRun r = runCheck(scenario + " --plan " + plan);
   EXPECT_EQ(r.status, 1) << r.output;  // the goal is not reached
   EXPECT_NE(r.output.find("3 of 3 stances valid"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("does not meet the goal"), std::string::npos) << r.output;
 
   // The same plan against a scenario whose goal it meets: valid.
-  std::string text = test::readFile(scenario);
-  const std::string root = test::sourcePath("models/");
-  text.replace(text.find("../hrp2/"), 8, root + "hrp2/");
-  text.replace(text.find("../scenes/"), 10, root + "scenes/");
+  std::string text = test::scenarioText("models/scenarios/chair_table.yaml");
   text.replace(text.find("goal: {link: WAIST, axis: y, min: 0.80}"), 39, "goal: {link: WAIST, axis: z, max: 1.0}");
-  const CheckRun ok = runCheck(dir.write("s.yaml", text) + " --plan " + plan + " -v");
+  const test::ProcessRun ok = runCheck(dir.write("s.yaml", text) + " --plan " + plan + " -v");
   EXPECT_EQ(ok.status, 0) << ok.output;
   EXPECT_NE(ok.output.find("plan: valid"), std::string::npos) << ok.output;
   EXPECT_NE(ok.output.find("equilibrium"), std::string::npos) << ok.output;
 
-  const CheckRun bad = runCheck(scenario + " --plan " + dir.write("bad.json", "{\"format\": \"acyclic.plan/1\"}"));
+  const test::ProcessRun bad = runCheck(scenario + " --plan " + dir.write("bad.json", "{\"format\": \"acyclic.plan/1\"}"));
   EXPECT_EQ(bad.status, 2) << bad.output;
   EXPECT_NE(bad.output.find("joint_names"), std::string::npos) << bad.output;
 }

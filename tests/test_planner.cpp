@@ -85,10 +85,7 @@ TEST(ContactPlanner, CancelledFromAnotherThread) {
 
 TEST(ContactPlanner, InvalidStartIsRefused) {
   test::TempDir dir;
-  std::string text = test::readFile(test::sourcePath("models/scenarios/step_forward.yaml"));
-  const std::string root = test::sourcePath("models/");
-  text.replace(text.find("../hrp2/"), 8, root + "hrp2/");
-  text.replace(text.find("../scenes/"), 10, root + "scenes/");
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
   text.replace(text.find("configuration: {posture: half_sitting}"), 38,
                "configuration: {posture: half_sitting, base_position: [0, 0, 0.60]}");  // feet 5 cm into the floor
   const Scenario sc = Scenario::load(dir.write("s.yaml", text));
@@ -118,10 +115,7 @@ TEST(ContactPlanner, AblationsStillPlanValidly) {
 
 TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   test::TempDir dir;
-  std::string text = test::readFile(test::sourcePath("models/scenarios/step_forward.yaml"));
-  const std::string root = test::sourcePath("models/");
-  text.replace(text.find("../hrp2/"), 8, root + "hrp2/");
-  text.replace(text.find("../scenes/"), 10, root + "scenes/");
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
   const Scenario plain = Scenario::load(dir.write("a.yaml", text));
   EXPECT_EQ(plannerParameters(plain).max_nodes, PlannerParameters().max_nodes);
   const Scenario tuned =

@@ -2,7 +2,9 @@
 // Helpers shared by the tests: paths, finite differences, temporary files.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
+#include <sys/wait.h>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -42,6 +44,30 @@ inline double relativeError(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, 
 inline std::string readFile(const std::string& path) {
   std::ifstream in(path);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Runs a command line; returns its exit status and what it printed (stdout and stderr).
+struct ProcessRun {
+  int status;
+  std::string output;
+};
+inline ProcessRun runProcess(const std::string& command) {
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+// A scenario file's text with its robot and scene paths made absolute, so that
+// a test can change it and write it anywhere.
+inline std::string scenarioText(const std::string& rel) {
+  std::string text = readFile(sourcePath(rel));
+  const std::string models = sourcePath("models/");
+  text.replace(text.find("../hrp2/"), 8, models + "hrp2/");
+  text.replace(text.find("../scenes/"), 10, models + "scenes/");
+  return text;
 }
 
 }  // namespace acyclic::test

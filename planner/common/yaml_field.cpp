@@ -122,6 +122,16 @@ Eigen::Vector2d YamlField::vec2() const {
   return {v[0], v[1]};
 }
 
+ConvexPolygon YamlField::polygon() const {
+  std::vector<Eigen::Vector2d> pts;
+  for (std::size_t k = 0; k < size(); ++k) pts.push_back(at(k).vec2());
+  try {
+    return ConvexPolygon(pts);
+  } catch (const std::invalid_argument& e) {
+    fail(std::string("a convex polygon [[x, y], ...] (") + e.what() + ")");
+  }
+}
+
 void YamlField::allowOnly(const std::vector<std::string>& allowed) const {
   for (const auto& k : keys()) {
     bool ok = false;

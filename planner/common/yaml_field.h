@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "planner/common/format_error.h"
+#include "planner/common/geometry.h"
 
 namespace acyclic {
 
@@ -44,6 +45,8 @@ class YamlField {
   std::vector<double> numbers(std::size_t n) const;    // exactly n
   Eigen::Vector3d vec3() const;
   Eigen::Vector2d vec2() const;
+  // A convex polygon [[x, y], ...]; the error says why one is not.
+  ConvexPolygon polygon() const;
 
   // Rejects keys not in `allowed` (a typo should not be silently ignored).
   void allowOnly(const std::vector<std::string>& allowed) const;

@@ -213,14 +213,7 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
       cs.link = m->linkIndex(s["body"].string());
       if (cs.link < 0) s["body"].fail("a link of the URDF");
       cs.frame = readPose(s);
-      std::vector<Eigen::Vector2d> pts;
-      YamlField poly = s["polygon"];
-      for (std::size_t i = 0; i < poly.size(); ++i) pts.push_back(poly.at(i).vec2());
-      try {
-        cs.polygon = ConvexPolygon(pts);
-      } catch (const std::invalid_argument& e) {
-        poly.fail(std::string("a convex polygon [[x, y], ...] (") + e.what() + ")");
-      }
+      cs.polygon = s["polygon"].polygon();
       m->spots_.push_back(cs);
     }
   }

@@ -66,14 +66,7 @@ std::shared_ptr<const Scene> Scene::load(const std::string& path) {
     su.obstacle = scene->obstacleIndex(s["obstacle"].string());
     if (su.obstacle < 0) s["obstacle"].fail("the name of an obstacle of this scene");
     su.frame = readPose(s);
-    std::vector<Eigen::Vector2d> pts;
-    YamlField poly = s["polygon"];
-    for (std::size_t k = 0; k < poly.size(); ++k) pts.push_back(poly.at(k).vec2());
-    try {
-      su.polygon = ConvexPolygon(pts);
-    } catch (const std::invalid_argument& e) {
-      poly.fail(std::string("a convex polygon [[x, y], ...] (") + e.what() + ")");
-    }
+    su.polygon = s["polygon"].polygon();
     su.friction = s["friction"].number();
     if (su.friction <= 0 || su.friction > 5) s["friction"].fail("a friction coefficient in (0, 5]");
     scene->surfaces_.push_back(su);
