@@ -104,6 +104,44 @@ TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
   }
 }
 
+TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
+  // Every block but the collision rows' curvature (left out, multipliers zero
+  // here) and the base rotation's own block (second-order parameterization
+  // terms, checked loosely) against differences of the constraint Jacobian.
+  const Scenario& sc = chair();
+  auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
+  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), {});
+  std::mt19937 rng(2);
+  std::normal_distribution<double> n(0, 0.05);
+  Eigen::VectorXd x = p.initialPoint();
+  for (int i = 0; i < p.numVariables(); ++i)
+    if (i < 3 || (i >= 6 && i < sc.robot->tangentSize() + 3)) x[i] += n(rng);  // base rotation at the guess
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(p.numConstraints());
+  for (int i = 0; i < p.collisionRow(); ++i) y[i] = 10 * n(rng);  // contact, floating and statics rows
+  const Eigen::MatrixXd H = p.lagrangianHessian(x, 0.0, y);
+  EXPECT_LT((H - H.transpose()).norm(), 1e-12);
+  Eigen::MatrixXd Hn(x.size(), x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd a = x, b = x;
+    a[i] += 1e-6;
+    b[i] -= 1e-6;
+    // the Jacobian is a reference to the problem's cache: copy each product before the next evaluation
+    const Eigen::VectorXd ga = p.constraintJacobian(a).transpose() * y;
+    const Eigen::VectorXd gb = p.constraintJacobian(b).transpose() * y;
+    Hn.col(i) = (ga - gb) / 2e-6;
+  }
+  const int nq = sc.robot->tangentSize(), nx = p.numVariables();
+  auto block = [&](int r0, int nr, int c0, int nc) {
+    return test::relativeError(H.block(r0, c0, nr, nc), Hn.block(r0, c0, nr, nc));
+  };
+  EXPECT_LT(block(6, nq - 6, 6, nq - 6), 1e-6) << "joints x joints";
+  EXPECT_LT(block(0, 3, 0, nq), 1e-6) << "base translation x configuration";
+  EXPECT_LT(block(3, 3, 6, nq - 6), 1e-6) << "base rotation x joints";
+  EXPECT_LT(block(3, 3, 3, 3), 1e-3) << "base rotation x base rotation";
+  EXPECT_LT(block(nq, 3, 0, nq + 3), 1e-6) << "floating contact";
+  EXPECT_LT(block(nq + 3, nx - nq - 3, 0, nq), 1e-6) << "forces x configuration";
+}
+
 TEST(PostureProblem, StaticsRowsAreSimbodysGravityTorques) {
   // With no contact force the joint rows are Simbody's g(q) / weight.
   const Scenario& sc = chair();

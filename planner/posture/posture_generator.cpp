@@ -27,15 +27,17 @@ namespace {
 // Ipopt's view of a PostureProblem.
 class PostureTNLP : public Ipopt::TNLP {
  public:
-  PostureTNLP(PostureProblem& p, const Eigen::VectorXd& x0, bool diagonal_hessian)
-      : p_(p), x0_(x0), diagonal_(diagonal_hessian) {}
+  enum class Hessian { LBFGS, Diagonal, Analytic };
+  PostureTNLP(PostureProblem& p, const Eigen::VectorXd& x0, Hessian h) : p_(p), x0_(x0), hessian_(h) {}
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
                     IndexStyleEnum& style) override {
     n = p_.numVariables();
     m = p_.numConstraints();
     nnz_jac = static_cast<Ipopt::Index>(p_.jacobianStructure().size());
-    nnz_h = diagonal_ ? n : 0;
+    nnz_h = hessian_ == Hessian::Diagonal ? n
+            : hessian_ == Hessian::Analytic ? static_cast<Ipopt::Index>(p_.hessianStructure().size())
+                                            : 0;
     style = C_STYLE;
     return true;
   }
@@ -78,9 +80,18 @@ class PostureTNLP : public Ipopt::TNLP {
     p_.jacobianValues(map(n, x), values);
     return true;
   }
-  bool eval_h(Ipopt::Index n, const Ipopt::Number*, bool, Ipopt::Number obj_factor, Ipopt::Index,
-              const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols,
+  bool eval_h(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index m,
+              const Ipopt::Number* lambda, bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols,
               Ipopt::Number* values) override {
+    if (hessian_ == Hessian::Analytic) {
+      if (!values) {
+        const auto& s = p_.hessianStructure();
+        for (std::size_t k = 0; k < s.size(); ++k) rows[k] = s[k].first, cols[k] = s[k].second;
+        return true;
+      }
+      p_.hessianValues(map(n, x), obj_factor, Eigen::Map<const Eigen::VectorXd>(lambda, m), values);
+      return true;
+    }
     if (!values) {
       for (Ipopt::Index i = 0; i < n; ++i) rows[i] = cols[i] = i;
       return true;
@@ -112,7 +123,7 @@ class PostureTNLP : public Ipopt::TNLP {
   static Eigen::VectorXd map(Ipopt::Index n, const Ipopt::Number* x) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
   PostureProblem& p_;
   Eigen::VectorXd x0_;
-  bool diagonal_;
+  Hessian hessian_;
   Eigen::VectorXd hdiag_;
 };
 
@@ -134,8 +145,8 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   o->SetStringValue("sb", "yes");  // no banner
   o->SetIntegerValue("print_level", opt_.print_level);
   if (opt_.print_level >= 4) o->SetStringValue("print_timing_statistics", "yes");
-  if (opt_.hessian != "diagonal" && opt_.hessian != "lbfgs")
-    throw std::invalid_argument("PostureGeneratorOptions::hessian: expected diagonal or lbfgs");
+  if (opt_.hessian != "diagonal" && opt_.hessian != "lbfgs" && opt_.hessian != "analytic")
+    throw std::invalid_argument("PostureGeneratorOptions::hessian: expected lbfgs, analytic or diagonal");
   o->SetStringValue("hessian_approximation", opt_.hessian == "lbfgs" ? "limited-memory" : "exact");
   o->SetStringValue("mu_strategy", "adaptive");
   o->SetNumericValue("tol", opt_.tolerance);
@@ -189,7 +200,10 @@ PostureResult PostureGenerator::solve(const PostureRequest& request) {
 
   Eigen::VectorXd x0 = problem->initialPoint();
   for (int round = 0; round <= opt_.collision_rounds; ++round) {
-    ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0, opt_.hessian == "diagonal");
+    const auto kind = opt_.hessian == "lbfgs"      ? PostureTNLP::Hessian::LBFGS
+                      : opt_.hessian == "analytic" ? PostureTNLP::Hessian::Analytic
+                                                   : PostureTNLP::Hessian::Diagonal;
+    ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0, kind);
     const double budget = opt_.max_seconds - elapsed();
     if (budget <= 0) {
       res.status = PostureResult::Status::TimeLimit;

@@ -18,8 +18,9 @@ struct PostureGeneratorOptions {
   double max_seconds = 0.25;          // CPU seconds per solve (Ipopt's max_cpu_time)
   double tolerance = 1e-6;            // Ipopt's tol and constr_viol_tol
   int collision_rounds = 3;           // re-solves when a pair left out of the problem collides
-  // Curvature: "diagonal" (the cost's, constant: one factorization per
-  // iteration) or "lbfgs" (Ipopt's limited-memory quasi-Newton).
+  // Curvature: "lbfgs" (Ipopt's limited-memory quasi-Newton: the default, the
+  // best measured by bench_posture), "analytic" (PostureProblem's Hessian of
+  // the Lagrangian) or "diagonal" (the cost's, constant).
   std::string hessian = "lbfgs";
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).

@@ -1,5 +1,6 @@
 #include "planner/posture/posture_problem.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -179,6 +180,13 @@ void PostureProblem::layout() {
     if (p.kind == CollisionPair::Kind::Self) linkCols(p.link_b, mask);
     emit(row_collision_ + static_cast<int>(k), mask);
   }
+  hstructure_.clear();
+  for (int r = 0; r < x_lambda_; ++r)  // configuration and floating variables
+    for (int c = 0; c <= r; ++c) hstructure_.push_back({r, c});
+  for (int r = x_lambda_; r < nx_; ++r) {
+    for (int c = 0; c < nq_; ++c) hstructure_.push_back({r, c});
+    hstructure_.push_back({r, r});
+  }
   valid_ = false;
 }
 
@@ -269,6 +277,184 @@ Eigen::VectorXd PostureProblem::hessianDiagonal() const {
   if (x_float_ >= 0) d.segment<3>(x_float_).setConstant(1e-3);
   d.segment(x_lambda_, n_lambda_).setConstant(2 * opt_.force_regularization);
   return d;
+}
+
+namespace {
+
+// A rotational degree of freedom moving a link: the base rotation about the
+// base origin (three, "base" true) or a joint, in chain order.
+struct Dof {
+  int col;
+  Eigen::Vector3d axis, origin;
+  bool base;
+};
+
+// d^n p / dq_1 .. dq_n for a point p moving with the link, the dofs given in
+// chain order: a_1 x (a_2 x ( ... (a_n x (p - o_n)))). Base rotations do not
+// form a chain: their orderings are averaged.
+Eigen::Vector3d nested(std::vector<const Dof*> d, const Eigen::Vector3d& p) {
+  auto chain = [&](const std::vector<const Dof*>& s) {
+    Eigen::Vector3d v = s.back()->axis.cross(p - s.back()->origin);
+    for (int i = static_cast<int>(s.size()) - 2; i >= 0; --i) v = s[i]->axis.cross(v);
+    return v;
+  };
+  int nb = 0;
+  while (nb < static_cast<int>(d.size()) && d[nb]->base) ++nb;
+  if (nb < 2) return chain(d);
+  std::sort(d.begin(), d.begin() + nb);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  do {
+    sum += chain(d);
+    ++count;
+  } while (std::next_permutation(d.begin(), d.begin() + nb));
+  return sum / count;
+}
+
+}  // namespace
+
+Eigen::MatrixXd PostureProblem::lagrangianHessian(const Eigen::VectorXd& x, double sigma, const Eigen::VectorXd& y) {
+  evaluate(x);  // kinematics at x
+  const RobotModel& m = *robot_;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(nx_, nx_);
+  H.diagonal() = sigma * hessianDiagonal();
+  const Eigen::Vector3d pb = kin_.linkPose(0).translation();
+  auto dofsOf = [&](int link) {
+    std::vector<Dof> d;
+    for (int k = 0; k < 3; ++k) d.push_back({3 + k, Eigen::Vector3d::Unit(k), pb, true});
+    for (int j : m.ancestorJoints(link)) d.push_back({6 + j, kin_.jointAxis(j), kin_.jointOrigin(j), false});
+    return d;
+  };
+  // v . d2p/dqi dqj for a point p on a link (or, with is_axis, a direction u on it).
+  auto addSecond = [&](int link, const Eigen::Vector3d& p, bool is_axis, const Eigen::Vector3d& v) {
+    std::vector<Dof> d = dofsOf(link);
+    if (is_axis)
+      for (auto& e : d) e.origin.setZero();  // a direction turns about any point alike
+    for (std::size_t j = 0; j < d.size(); ++j)
+      for (std::size_t i = 0; i <= j; ++i) {
+        const double h = v.dot(nested({&d[i], &d[j]}, p));
+        H(d[j].col, d[i].col) += h;
+        if (i != j) H(d[i].col, d[j].col) += h;
+      }
+  };
+
+  // Contact rows.
+  const int n_fixed = static_cast<int>(req_.contacts.size());
+  for (int ci = 0; ci < n_fixed + (req_.floating ? 1 : 0); ++ci) {
+    const bool floating = ci == n_fixed;
+    const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
+    const Surface& surf = scene_->surfaces()[floating ? req_.floating->surface : req_.contacts[ci].surface];
+    const SurfacePlacement pl = floating ? floatingAt(x) : req_.contacts[ci].placement;
+    const int link = m.spots()[spot].link;
+    const Eigen::Isometry3d Ts = kin_.spotPose(spot);
+    const Eigen::Isometry3d T = contactFrame(surf, pl);
+    const int r = 6 * ci;
+    const Eigen::Vector3d zs = Ts.linear().col(2), xs = Ts.linear().col(0);
+    const Eigen::Vector3d xt = T.linear().col(0), yt = T.linear().col(1);
+    addSecond(link, Ts.translation(), false, y.segment<3>(r));
+    addSecond(link, zs, true, y[r + 3] * xt + y[r + 4] * yt);
+    addSecond(link, xs, true, y[r + 5] * yt);
+    if (floating) {
+      const int th = x_float_ + 2;
+      H(th, th) += -y[r + 3] * zs.dot(xt) - y[r + 4] * zs.dot(yt) - y[r + 5] * xs.dot(yt);
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(nq_);
+      kin_.addAxisGradient(link, zs, y[r + 3] * yt - y[r + 4] * xt, g);
+      kin_.addAxisGradient(link, xs, -y[r + 5] * xt, g);
+      H.block(th, 0, 1, nq_) += g.transpose();
+      H.block(0, th, nq_, 1) += g;
+    }
+  }
+  if (req_.floating) {
+    const auto& f = *req_.floating;
+    std::vector<Eigen::Vector2d> n;
+    std::vector<double> b;
+    halfPlanes(scene_->surfaces()[f.surface].polygon, n, b);
+    const Eigen::Matrix2d R = Eigen::Rotation2Dd(x[x_float_ + 2]).toRotationMatrix();
+    int r = row_floating_ + static_cast<int>(f.volume.polygon.size());
+    for (const auto& c : m.spots()[f.spot].polygon.vertices())
+      for (const auto& ne : n) H(x_float_ + 2, x_float_ + 2) += -y[r++] * ne.dot(R * c);
+  }
+
+  // Statics rows (in weights; forces W lambda g).
+  const double M = m.totalMass(), W = M * 9.81;
+  const Eigen::Vector3d gvec(0, 0, -9.81), G = M * gvec;
+  const Eigen::Vector3d ym = y.segment<3>(row_statics_ + 3);
+  for (const auto& l : m.links()) {
+    const Eigen::Vector3d cl = kin_.linkPose(l.index) * l.com;
+    // moment rows: -(c x G) / W, c = sum m_l c_l / M
+    addSecond(l.index, cl, false, -(l.mass / (M * W)) * G.cross(ym));
+    // torque rows, gravity: -(m_l g / W) . d3 c_l / dqa dqb dqj
+    const std::vector<Dof> d = dofsOf(l.index);
+    const Eigen::Vector3d w = -(l.mass / W) * gvec;
+    for (std::size_t jj = 3; jj < d.size(); ++jj) {
+      const double yj = y[row_statics_ + d[jj].col];
+      if (yj == 0) continue;
+      for (std::size_t b = 0; b < d.size(); ++b)
+        for (std::size_t a = 0; a <= b; ++a) {
+          std::vector<const Dof*> s = {&d[a], &d[b], &d[jj]};
+          std::sort(s.begin(), s.end(), [&](const Dof* p, const Dof* q) { return p - d.data() < q - d.data(); });
+          const double h = yj * w.dot(nested(s, cl));
+          H(d[b].col, d[a].col) += h;
+          if (a != b) H(d[a].col, d[b].col) += h;
+        }
+    }
+  }
+  // torque rows, contact forces at fixed world points: -(f / W) . d2[a_j x (p - o_j)]
+  for (const auto& s : supports_) {
+    const int ng = static_cast<int>(s.generators.size());
+    const std::vector<Dof> d = dofsOf(s.link);
+    for (std::size_t k = 0; k < s.corners.size(); ++k) {
+      Eigen::Vector3d f = Eigen::Vector3d::Zero();
+      for (int mm = 0; mm < ng; ++mm) f += x[s.lambda0 + k * ng + mm] * s.generators[mm];  // / W already
+      const Eigen::Vector3d& p = s.corners[k];
+      for (std::size_t jj = 3; jj < d.size(); ++jj) {
+        const double yj = y[row_statics_ + d[jj].col];
+        if (yj == 0) continue;
+        const Eigen::Vector3d& a = d[jj].axis;
+        const Eigen::Vector3d& o = d[jj].origin;
+        // derivatives of a_j and o_j under the dofs above j, and translation
+        auto da = [&](std::size_t i) { return Eigen::Vector3d(d[i].axis.cross(a)); };
+        auto dO = [&](std::size_t i) { return Eigen::Vector3d(d[i].axis.cross(o - d[i].origin)); };
+        for (std::size_t h = 0; h < jj; ++h) {
+          for (std::size_t i = 0; i <= h; ++i) {
+            const Eigen::Vector3d d2a = nested({&d[i], &d[h]}, a + d[h].origin) ;  // a_i x (a_h x a)
+            const Eigen::Vector3d d2o = nested({&d[i], &d[h]}, o);
+            const Eigen::Vector3d v = d2a.cross(p - o) - da(i).cross(dO(h)) - da(h).cross(dO(i)) - a.cross(d2o);
+            const double val = -yj * f.dot(v);
+            H(d[h].col, d[i].col) += val;
+            if (i != h) H(d[i].col, d[h].col) += val;
+          }
+          // translation t: d o_j = e_t; d2/dt dq_h = -(d a_j / dq_h) x e_t
+          for (int t3 = 0; t3 < 3; ++t3) {
+            const double val = -yj * f.dot(-da(h).cross(Eigen::Vector3d::Unit(t3)));
+            H(d[h].col, t3) += val;
+            H(t3, d[h].col) += val;
+          }
+        }
+        // force coupling: d/dlambda of the torque row's configuration derivatives
+        for (int mm = 0; mm < ng; ++mm) {
+          const int col = s.lambda0 + static_cast<int>(k) * ng + mm;
+          const Eigen::Vector3d& g = s.generators[mm];
+          const Eigen::Vector3d arm = (p - o).cross(g);
+          for (int c = 0; c < 3; ++c) H(col, c) += yj * g.cross(a)[c];
+          for (std::size_t i = 0; i < jj; ++i)
+            H(col, d[i].col) += -yj * (da(i).dot(arm) - a.dot(dO(i).cross(g)));
+        }
+      }
+    }
+  }
+  for (int r = x_lambda_; r < nx_; ++r) H.block(0, r, nq_, 1) = H.block(r, 0, 1, nq_).transpose();
+
+  // Base rotation vector: first-order chain rule (J_l), as for the Jacobian.
+  const Eigen::Matrix3d Jl = leftJacobian(x.segment<3>(3));
+  H.middleCols(3, 3) = H.middleCols(3, 3) * Jl;
+  H.middleRows(3, 3) = Jl.transpose() * H.middleRows(3, 3);
+  return H;
+}
+
+void PostureProblem::hessianValues(const Eigen::VectorXd& x, double sigma, const Eigen::VectorXd& y, double* values) {
+  const Eigen::MatrixXd H = lagrangianHessian(x, sigma, y);
+  for (std::size_t k = 0; k < hstructure_.size(); ++k) values[k] = H(hstructure_[k].first, hstructure_[k].second);
 }
 
 Configuration PostureProblem::configurationAt(const Eigen::VectorXd& x) const {

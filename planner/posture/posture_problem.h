@@ -88,6 +88,16 @@ class PostureProblem {
   // cost's curvature, the constraints' neglected.
   Eigen::VectorXd hessianDiagonal() const;
 
+  // The Hessian of the Lagrangian sigma f + sum y_i g_i, analytic but for:
+  // the cost (its diagonal), the collision rows' curvature (left out), and the
+  // second-order terms of the base rotation-vector parameterization. Contact,
+  // floating-contact and statics rows (gravity and contact forces, through
+  // nested products of the joint axes) are exact.
+  // Lower triangle, in the order of hessianStructure().
+  const std::vector<std::pair<int, int>>& hessianStructure() const { return hstructure_; }
+  Eigen::MatrixXd lagrangianHessian(const Eigen::VectorXd& x, double sigma, const Eigen::VectorXd& y);  // dense, symmetric
+  void hessianValues(const Eigen::VectorXd& x, double sigma, const Eigen::VectorXd& y, double* values);
+
   Configuration configurationAt(const Eigen::VectorXd& x) const;
   SurfacePlacement floatingAt(const Eigen::VectorXd& x) const;
   // World corner points and forces of each supporting contact.
@@ -130,7 +140,7 @@ class PostureProblem {
   int nq_ = 0, nx_ = 0, ng_ = 0;
   int x_float_ = -1, x_lambda_ = -1, n_lambda_ = 0;
   int row_floating_ = 0, n_float_rows_ = 0, row_statics_ = 0, row_collision_ = 0;
-  std::vector<std::pair<int, int>> structure_;
+  std::vector<std::pair<int, int>> structure_, hstructure_;
 
   // Evaluation cache.
   bool valid_ = false;
