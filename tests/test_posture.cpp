@@ -216,6 +216,29 @@ TEST(PostureGenerator, LeftWristAnywhereOnTheTable) {  // (c)
   expectValid(sc, res, stance);
 }
 
+TEST(PostureGenerator, AFloatingContactsPlacementIsAcceptedAsAFixedContact) {
+  // The solver meets the floating polygon's bounds only to its tolerance; the
+  // same placement, fixed in the next request, must not be refused.
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  PostureRequest r = wristOnTable(sc);
+  r.floating->volume.polygon = ConvexPolygon({{-0.4, -0.6}, {-0.3, -0.6}, {-0.3, 0.6}, {-0.4, 0.6}});  // the near edge
+  const PostureResult a = pg.solve(r);
+  ASSERT_TRUE(a.success()) << a.reason;
+  ContactSpec wrist;
+  wrist.spot = r.floating->spot;
+  wrist.surface = r.floating->surface;
+  wrist.supporting = false;
+  wrist.placement = a.floating;
+  PostureRequest next;
+  next.contacts = sc.start_stance;
+  next.contacts.push_back(wrist);
+  next.initial_guess = a.configuration;
+  const PostureResult b = pg.solve(next);
+  EXPECT_NE(b.status, PostureResult::Status::BadInput) << b.reason;
+  EXPECT_TRUE(b.success()) << b.reason;
+}
+
 TEST(PostureGenerator, ContactOutOfReachIsInfeasibleWithinItsTimeLimit) {  // (d)
   const Scenario& sc = chair();
   PostureGeneratorOptions o;

@@ -12,6 +12,11 @@ namespace acyclic {
 
 namespace {
 constexpr double kInf = 1e19;  // Ipopt's infinity
+// A floating contact's spot polygon is kept this far inside its surface, so
+// that the same placement, later a fixed contact, passes the check below
+// (the contract allows 1 mm; the solver meets its bounds only to tolerance).
+constexpr double kFloatingPolygonMargin = 1e-4;
+constexpr double kContactPolygonTolerance = 1e-3;
 const Eigen::Vector3d kGravity(0, 0, -9.81);
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
@@ -62,7 +67,7 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
     for (const auto& v : robot_->spots()[c.spot].polygon.vertices()) {
       const Eigen::Vector2d p = Eigen::Vector2d(c.placement.x, c.placement.y) +
                                 Eigen::Rotation2Dd(c.placement.theta) * v;
-      if (!s.polygon.contains(p, 1e-9))
+      if (!s.polygon.contains(p, kContactPolygonTolerance))
         throw std::invalid_argument("contact " + robot_->spots()[c.spot].name + "@" + s.name +
                                     ": the spot polygon leaves the surface polygon");
     }
@@ -216,7 +221,7 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
     n.clear(), b.clear();
     halfPlanes(scene_->surfaces()[f.surface].polygon, n, b);
     for (std::size_t k = 0; k < robot_->spots()[f.spot].polygon.size(); ++k)
-      for (double bi : b) gl[r] = -kInf, gu[r++] = bi;
+      for (double bi : b) gl[r] = -kInf, gu[r++] = bi - kFloatingPolygonMargin;
   }
   for (const auto& j : robot_->joints()) {
     const double W = robot_->totalMass() * 9.81;  // statics rows are in units of the weight
