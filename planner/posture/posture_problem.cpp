@@ -344,15 +344,12 @@ Eigen::MatrixXd PostureProblem::lagrangianHessian(const Eigen::VectorXd& x, doub
   };
 
   // Contact rows.
-  const int n_fixed = static_cast<int>(req_.contacts.size());
-  for (int ci = 0; ci < n_fixed + (req_.floating ? 1 : 0); ++ci) {
-    const bool floating = ci == n_fixed;
-    const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
-    const Surface& surf = scene_->surfaces()[floating ? req_.floating->surface : req_.contacts[ci].surface];
-    const SurfacePlacement pl = floating ? floatingAt(x) : req_.contacts[ci].placement;
-    const int link = m.spots()[spot].link;
-    const Eigen::Isometry3d Ts = kin_.spotPose(spot);
-    const Eigen::Isometry3d T = contactFrame(surf, pl);
+  for (int ci = 0; ci < numContacts(); ++ci) {
+    const ContactGeometry cg = contactGeometry(ci, x);
+    const bool floating = cg.floating;
+    const int link = cg.link;
+    const Eigen::Isometry3d& Ts = cg.spot;
+    const Eigen::Isometry3d& T = cg.target;
     const int r = 6 * ci;
     const Eigen::Vector3d zs = Ts.linear().col(2), xs = Ts.linear().col(0);
     const Eigen::Vector3d xt = T.linear().col(0), yt = T.linear().col(1);
@@ -494,6 +491,14 @@ std::vector<PostureProblem::ContactForces> PostureProblem::forcesAt(const Eigen:
   return out;
 }
 
+PostureProblem::ContactGeometry PostureProblem::contactGeometry(int ci, const Eigen::VectorXd& x) const {
+  const bool floating = ci == static_cast<int>(req_.contacts.size());
+  const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
+  const Surface& surf = scene_->surfaces()[floating ? req_.floating->surface : req_.contacts[ci].surface];
+  const SurfacePlacement pl = floating ? floatingAt(x) : req_.contacts[ci].placement;
+  return {floating, robot_->spots()[spot].link, kin_.spotPose(spot), contactFrame(surf, pl)};
+}
+
 Eigen::Matrix3d PostureProblem::leftJacobian(const Eigen::Vector3d& w) const {
   // d/de exp(w + e v) = [J_l(w) v]x exp(w): maps rotation-vector steps to world rotations.
   const double th = w.norm();
@@ -521,15 +526,12 @@ void PostureProblem::evaluate(const Eigen::VectorXd& x) {
   grad_f_.segment(x_lambda_, n_lambda_) = 2 * opt_.force_regularization * lam;
 
   // Contacts.
-  const int n_fixed = static_cast<int>(req_.contacts.size());
-  for (int ci = 0; ci < n_fixed + (req_.floating ? 1 : 0); ++ci) {
-    const bool floating = ci == n_fixed;
-    const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
-    const Surface& surf = scene_->surfaces()[floating ? req_.floating->surface : req_.contacts[ci].surface];
-    const SurfacePlacement pl = floating ? floatingAt(x) : req_.contacts[ci].placement;
-    const int link = m.spots()[spot].link;
-    const Eigen::Isometry3d Ts = kin_.spotPose(spot);
-    const Eigen::Isometry3d T = contactFrame(surf, pl);
+  for (int ci = 0; ci < numContacts(); ++ci) {
+    const ContactGeometry cg = contactGeometry(ci, x);
+    const bool floating = cg.floating;
+    const int link = cg.link;
+    const Eigen::Isometry3d& Ts = cg.spot;
+    const Eigen::Isometry3d& T = cg.target;
     const int r = 6 * ci;
     g_.segment<3>(r) = Ts.translation() - T.translation();
     jac_.block(r, 0, 3, nq_) = kin_.chainPointJacobian(link, Ts.translation());
@@ -543,7 +545,7 @@ void PostureProblem::evaluate(const Eigen::VectorXd& x) {
       jac_.block(r + 3 + k, 0, 1, nq_) = row.transpose();
     }
     if (floating) {
-      const Eigen::Matrix3d SR = surf.frame.linear();
+      const Eigen::Matrix3d SR = scene_->surfaces()[req_.floating->surface].frame.linear();
       jac_.block(r, x_float_, 3, 1) = -SR.col(0);
       jac_.block(r, x_float_ + 1, 3, 1) = -SR.col(1);
       // d x_t / d theta = y_t, d y_t / d theta = -x_t

@@ -123,6 +123,15 @@ class PostureProblem {
     std::vector<Eigen::Vector3d> generators;  // unit, world
     int lambda0;               // first lambda variable
   };
+  // Contact ci (the floating one last) at the current kinematics: its spot's
+  // link, the spot's world frame and the target frame it must coincide with.
+  struct ContactGeometry {
+    bool floating;
+    int link;
+    Eigen::Isometry3d spot, target;
+  };
+  int numContacts() const { return static_cast<int>(req_.contacts.size()) + (req_.floating ? 1 : 0); }
+  ContactGeometry contactGeometry(int ci, const Eigen::VectorXd& x) const;
   void layout();
   void evaluate(const Eigen::VectorXd& x);
   Eigen::Matrix3d leftJacobian(const Eigen::Vector3d& w) const;
