@@ -18,20 +18,25 @@ double binomial(int n, int k) {
   return r;
 }
 
-// d-th derivative of a Bezier curve with control points P at t.
-Eigen::VectorXd bezier(const std::vector<Eigen::VectorXd>& P, double t, int d) {
-  std::vector<Eigen::VectorXd> Q = P;
-  int n = static_cast<int>(P.size()) - 1;
-  double scale = 1;
-  for (int k = 0; k < d; ++k) {  // hodograph
-    for (int i = 0; i + 1 < static_cast<int>(Q.size()); ++i) Q[i] = Q[i + 1] - Q[i];
-    Q.pop_back();
-    scale *= n - k;
+// Control points of the first `n` derivatives of a Bezier curve (hodographs), index 0 the curve itself.
+std::vector<std::vector<Eigen::VectorXd>> hodographs(const std::vector<Eigen::VectorXd>& P, int n) {
+  std::vector<std::vector<Eigen::VectorXd>> out = {P};
+  for (int d = 1; d <= n; ++d) {
+    const auto& Q = out.back();
+    const double degree = static_cast<double>(Q.size()) - 1;
+    std::vector<Eigen::VectorXd> next;
+    for (std::size_t i = 0; i + 1 < Q.size(); ++i) next.push_back(degree * (Q[i + 1] - Q[i]));
+    out.push_back(next);
   }
+  return out;
+}
+
+// A Bezier curve with control points Q at t (Bernstein form).
+Eigen::VectorXd bernstein(const std::vector<Eigen::VectorXd>& Q, double t) {
   const int m = static_cast<int>(Q.size()) - 1;
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(P[0].size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(Q[0].size());
   for (int i = 0; i <= m; ++i) out += binomial(m, i) * std::pow(t, i) * std::pow(1 - t, m - i) * Q[i];
-  return scale * out;
+  return out;
 }
 
 // 5-point Gauss-Legendre on [a, b].
@@ -66,7 +71,7 @@ double blendDeviation(const std::vector<Eigen::VectorXd>& ctrl, const Eigen::Vec
                       const Eigen::VectorXd& u2) {
   double worst = 0;
   for (int k = 0; k <= 100; ++k) {
-    const Eigen::VectorXd c = bezier(ctrl, k / 100.0, 0) - V;
+    const Eigen::VectorXd c = bernstein(ctrl, k / 100.0) - V;
     const double d1 = (c - std::min(0.0, c.dot(u1)) * u1).norm();
     const double d2 = (c - std::max(0.0, c.dot(u2)) * u2).norm();
     worst = std::max(worst, std::min(d1, d2));
@@ -136,13 +141,14 @@ GuidePotential::GuidePotential(const std::vector<Configuration>& key_postures, d
       b.V = keys_[i].head(6);
       for (int j = 0; j < 4; ++j) b.ctrl.push_back(b.V - t[i] * (1 - j / 3.0) * U[i - 1]);
       for (int j = 0; j < 4; ++j) b.ctrl.push_back(b.V + t[i] * (j / 3.0) * U[i]);
+      b.hodographs = hodographs(b.ctrl, 3);
       const int N = 64;
       b.tau_table.push_back(0);
       b.s_table.push_back(0);
       for (int k = 1; k <= N; ++k) {
         const double a = (k - 1.0) / N, c = static_cast<double>(k) / N;
         b.tau_table.push_back(c);
-        b.s_table.push_back(b.s_table.back() + gauss([&](double x) { return bezier(b.ctrl, x, 1).norm(); }, a, c));
+        b.s_table.push_back(b.s_table.back() + gauss([&](double x) { return blendPoint(b, x, 1).norm(); }, a, c));
       }
       b.len = b.s_table.back();
       b.s0 = s;
@@ -168,16 +174,22 @@ GuidePotential::GuidePotential(const std::vector<Configuration>& key_postures, d
   length_ = s;
 }
 
+Eigen::VectorXd GuidePotential::blendPoint(const Piece& p, double tau, int d) {
+  return bernstein(p.hodographs[d], tau);
+}
+
 Eigen::VectorXd GuidePotential::basePoint(const Piece& p, double tau, int d) const {
-  if (!p.blend) return d == 0 ? Eigen::VectorXd(p.a + tau * p.len * p.u) : Eigen::VectorXd(d == 1 ? Eigen::VectorXd(p.len * p.u) : Eigen::VectorXd::Zero(6));
-  return bezier(p.ctrl, tau, d);
+  if (p.blend) return blendPoint(p, tau, d);
+  if (d == 0) return p.a + tau * p.len * p.u;
+  if (d == 1) return p.len * p.u;
+  return Eigen::VectorXd::Zero(6);
 }
 
 double GuidePotential::arcLength(const Piece& p, double tau) const {
   if (!p.blend) return tau * p.len;
   const int N = static_cast<int>(p.tau_table.size()) - 1;
   const int k = std::min(N - 1, static_cast<int>(tau * N));
-  return p.s_table[k] + gauss([&](double x) { return bezier(p.ctrl, x, 1).norm(); }, p.tau_table[k], tau);
+  return p.s_table[k] + gauss([&](double x) { return blendPoint(p, x, 1).norm(); }, p.tau_table[k], tau);
 }
 
 double GuidePotential::tauAt(const Piece& p, double sl) const {
@@ -189,7 +201,7 @@ double GuidePotential::tauAt(const Piece& p, double sl) const {
   for (int it = 0; it < 20; ++it) {
     const double f = arcLength(p, tau) - sl;
     if (std::abs(f) < 1e-14) break;
-    tau = std::clamp(tau - f / bezier(p.ctrl, tau, 1).norm(), 0.0, 1.0);
+    tau = std::clamp(tau - f / blendPoint(p, tau, 1).norm(), 0.0, 1.0);
   }
   return tau;
 }
@@ -222,11 +234,11 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
       tau = 0;
       double bd = std::numeric_limits<double>::infinity();
       for (int k = 0; k <= 16; ++k) {
-        const double d = (bezier(p.ctrl, k / 16.0, 0) - Pb).squaredNorm();
+        const double d = (blendPoint(p, k / 16.0, 0) - Pb).squaredNorm();
         if (d < bd) bd = d, tau = k / 16.0;
       }
       for (int it = 0; it < 30; ++it) {  // Newton on (c - P) . c' = 0
-        const Eigen::VectorXd c = bezier(p.ctrl, tau, 0), c1 = bezier(p.ctrl, tau, 1), c2 = bezier(p.ctrl, tau, 2);
+        const Eigen::VectorXd c = blendPoint(p, tau, 0), c1 = blendPoint(p, tau, 1), c2 = blendPoint(p, tau, 2);
         const double g = (c - Pb).dot(c1), dg = c1.squaredNorm() + (c - Pb).dot(c2);
         const double next = std::clamp(tau - g / (dg > 0 ? dg : c1.squaredNorm()), 0.0, 1.0);
         if (std::abs(next - tau) < 1e-15) break;

@@ -61,8 +61,10 @@ class GuidePotential : public PostureCost {
     double s0 = 0, len = 0;
     // segment: base from a to a + len * u; joints (rest) linear from ra with slope m0
     Eigen::VectorXd a, u;
-    // blend: 8 control points (base), arc length table for the parameter
+    // blend: 8 control points (base) and those of its first three derivatives,
+    // arc length table for the parameter
     std::vector<Eigen::VectorXd> ctrl;
+    std::vector<std::vector<Eigen::VectorXd>> hodographs;  // [d]: control points of the d-th derivative
     std::vector<double> tau_table, s_table;
     // rest coordinates (joints): values and slopes at the piece's ends
     Eigen::VectorXd r0, r1, m0, m1;
@@ -70,6 +72,7 @@ class GuidePotential : public PostureCost {
   };
   double valueAndGradient(const Eigen::VectorXd& P, Eigen::VectorXd* grad) const;
   Eigen::VectorXd basePoint(const Piece& p, double tau, int derivative) const;
+  static Eigen::VectorXd blendPoint(const Piece& p, double tau, int derivative);
   double arcLength(const Piece& p, double tau) const;  // from the piece start
   double tauAt(const Piece& p, double s_local) const;
   void rest(const Piece& p, double s_local, Eigen::VectorXd& r, Eigen::VectorXd& dr) const;
