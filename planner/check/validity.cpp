@@ -26,13 +26,14 @@ ValidityChecker::ValidityChecker(std::shared_ptr<const RobotModel> robot, std::s
                                  ContractTolerances tol)
     : robot_(robot), scene_(scene), tol_(tol), kin_(robot), collision_(robot, scene), statics_(robot, scene) {}
 
-ValidityReport ValidityChecker::checkPosture(const Configuration& q, const std::vector<ContactSpec>& stance) {
+ValidityReport ValidityChecker::checkPosture(const Configuration& q, const std::vector<ContactSpec>& stance,
+                                             QuasiStaticReport* equilibrium) {
   ValidityReport r;
   r.parts.push_back(checkJointLimits(q));
   kin_.setConfiguration(q);
   r.parts.push_back(checkContacts(stance));
   r.parts.push_back(checkCollisions(stance));
-  r.parts.push_back(checkEquilibrium(stance));
+  r.parts.push_back(checkEquilibrium(stance, equilibrium));
   return r;
 }
 

@@ -40,7 +40,9 @@ class ValidityChecker {
   ValidityChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
                   ContractTolerances tol = {});
 
-  ValidityReport checkPosture(const Configuration& q, const std::vector<ContactSpec>& stance);
+  // `equilibrium`, if given, receives the quasi-static check's report (forces included).
+  ValidityReport checkPosture(const Configuration& q, const std::vector<ContactSpec>& stance,
+                              QuasiStaticReport* equilibrium = nullptr);
 
   CheckPart checkJointLimits(const Configuration& q) const;
   CheckPart checkContacts(const std::vector<ContactSpec>& stance);    // at the last set configuration

@@ -66,6 +66,7 @@ struct ContactPlanner::Impl {
   PlannerParameters p;
   PostureGenerator pg;
   ValidityChecker checker;
+  Kinematics kin;  // the search is single-threaded: one for every key, goal and reach test
   std::unique_ptr<GuidePotential> guide;
   std::mt19937 rng;
 
@@ -104,7 +105,8 @@ struct ContactPlanner::Impl {
   std::string stop_reason;
 
   Impl(const Scenario& s, PlannerParameters params)
-      : sc(s), p(std::move(params)), pg(s.robot, s.scene, p.posture), checker(s.robot, s.scene), rng(s.seed) {
+      : sc(s), p(std::move(params)), pg(s.robot, s.scene, p.posture), checker(s.robot, s.scene), kin(s.robot),
+        rng(s.seed) {
     if (p.guide_potential) {
       std::vector<Configuration> keys = sc.key_postures;
       if (keys.size() < 2) throw std::invalid_argument("the guide potential needs key postures (at least two)");
@@ -116,12 +118,11 @@ struct ContactPlanner::Impl {
     if (guide) return std::shared_ptr<const PostureCost>(guide.get(), [](const PostureCost*) {});
     return std::make_shared<GoalDistanceCost>(sc.goal, parent);
   }
-  double keyOf(const Configuration& q) const {
-    Kinematics k(sc.robot);
-    k.setConfiguration(q);
+  double keyOf(const Configuration& q) {
+    kin.setConfiguration(q);
     Eigen::VectorXd g = Eigen::VectorXd::Zero(q.tangentSize());
-    if (guide) return guide->evaluate(k, g);
-    return GoalDistanceCost(sc.goal, q).evaluate(k, g);
+    if (guide) return guide->evaluate(kin, g);
+    return GoalDistanceCost(sc.goal, q).evaluate(kin, g);
   }
   double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
@@ -204,20 +205,19 @@ struct ContactPlanner::Impl {
   }
 
   // Adds a son if its witness passes the independent check and no node is too
-  // close to it; returns its index or -1.
-  int addNode(Node n) {
+  // close to it; returns its index or -1. Its key is computed here unless given.
+  int addNode(Node n, bool key_given = false) {
     ++stats.nodes_generated;
     if (isDuplicate(n.contacts)) return -1;
     if (!checker.checkPosture(n.q, n.transition).valid()) {
       ++stats.check_refusals;
       return -1;
     }
-    n.key = keyOf(n.q);
+    if (!key_given) n.key = keyOf(n.q);  // leaves kin at n.q
+    else kin.setConfiguration(n.q);
     nodes.push_back(std::move(n));
     const int id = static_cast<int>(nodes.size()) - 1;
-    Kinematics k(sc.robot);
-    k.setConfiguration(nodes[id].q);
-    if (sc.goal.satisfied(k) && goal_node < 0) goal_node = id;
+    if (sc.goal.satisfied(kin) && goal_node < 0) goal_node = id;
     open.push({nodes[id].key, order++, id});
     if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) stats.best_potential = nodes[id].key;
     return id;
@@ -301,10 +301,10 @@ struct ContactPlanner::Impl {
       son.parent = g.node;
       son.change = Change::Added;
       son.generator = gi;
-      const double parent_key = keyOf(res.configuration);
+      son.key = keyOf(res.configuration);  // also orders the parts of its volume
       if (p.optimized_candidates)
-        for (auto& part : subtractBox(volume, res.floating, p.box)) gens[gi].volumes.push_back({parent_key, part});
-      const int id = addNode(son);
+        for (auto& part : subtractBox(volume, res.floating, p.box)) gens[gi].volumes.push_back({son.key, part});
+      const int id = addNode(son, true);
       if (id >= 0) return id;
     }
     return -1;
@@ -314,15 +314,14 @@ struct ContactPlanner::Impl {
     ++stats.nodes_expanded;
     removalSons(ni);
     if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return;
-    Kinematics parent_kin(sc.robot);
-    parent_kin.setConfiguration(nodes[ni].q);
     for (int spot : sc.allowed_spots) {
       bool used = false;
       for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
       if (used) continue;
       for (int surface : sc.allowed_surfaces) {
         if (!budgetLeft() || goal_node >= 0) return;
-        if (!reachable(spot, surface, parent_kin)) continue;
+        kin.setConfiguration(nodes[ni].q);  // nextSon below moves it
+        if (!reachable(spot, surface, kin)) continue;
         PairGenerator g;
         g.node = ni;
         g.spot = spot;
@@ -353,8 +352,7 @@ struct ContactPlanner::Impl {
       st.configuration = q;
       st.potential = keyOf(q);
       QuasiStaticReport eq;
-      checker.checkPosture(q, specs);
-      checker.checkEquilibrium(specs, &eq);
+      checker.checkPosture(q, specs, &eq);
       for (std::size_t i = 0; i < specs.size(); ++i) {
         PlanContact c;
         c.spec = specs[i];
