@@ -7,11 +7,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "planner/common/format_error.h"
+#include "planner/plan/json_field.h"
 
 namespace acyclic {
 
 using nlohmann::json;
+using json_field::J;
+using json_field::vec;
 
 std::vector<ContactSpec> PlanStance::specs() const {
   std::vector<ContactSpec> out;
@@ -19,52 +21,56 @@ std::vector<ContactSpec> PlanStance::specs() const {
   return out;
 }
 
-namespace {
 
-json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+namespace json_field {
 
-// Field access that names the file and the field on error.
-struct J {
-  const json& j;
-  const std::string& file;
-  std::string path;
-  [[noreturn]] void fail(const std::string& expected) const { throw FormatError(file, path, "expected " + expected); }
-  J at(const std::string& key) const {
-    if (!j.is_object()) fail("an object with a field '" + key + "'");
-    if (!j.contains(key)) throw FormatError(file, path.empty() ? key : path + "." + key, "missing (required)");
-    return {j.at(key), file, path.empty() ? key : path + "." + key};
-  }
-  bool has(const std::string& key) const { return j.is_object() && j.contains(key); }
-  J item(std::size_t i) const { return {j.at(i), file, path + "[" + std::to_string(i) + "]"}; }
-  std::size_t size() const {
-    if (!j.is_array()) fail("a list");
-    return j.size();
-  }
-  double number() const {
-    if (!j.is_number()) fail("a number");
-    return j.get<double>();
-  }
-  std::string string() const {
-    if (!j.is_string()) fail("a string");
-    return j.get<std::string>();
-  }
-  bool boolean() const {
-    if (!j.is_boolean()) fail("true or false");
-    return j.get<bool>();
-  }
-  std::vector<double> numbers(std::size_t n) const {
-    if (!j.is_array() || j.size() != n) fail("a list of " + std::to_string(n) + " numbers");
-    std::vector<double> v;
-    for (std::size_t i = 0; i < n; ++i) v.push_back(item(i).number());
-    return v;
-  }
-  Eigen::Vector3d vec3() const {
-    auto v = numbers(3);
-    return {v[0], v[1], v[2]};
-  }
-};
+json specToJson(const ContactSpec& c, const Scenario& sc) {
+  return {{"spot", sc.robot->spots()[c.spot].name},
+          {"surface", sc.scene->surfaces()[c.surface].name},
+          {"supporting", c.supporting},
+          {"x", c.placement.x},
+          {"y", c.placement.y},
+          {"theta", c.placement.theta}};
+}
 
-}  // namespace
+ContactSpec specFromJson(const J& jc, const Scenario& sc) {
+  ContactSpec c;
+  c.spot = sc.robot->spotIndex(jc.at("spot").string());
+  if (c.spot < 0) jc.at("spot").fail("a contact spot of the robot");
+  c.surface = sc.scene->surfaceIndex(jc.at("surface").string());
+  if (c.surface < 0) jc.at("surface").fail("a surface of the scene");
+  c.supporting = jc.at("supporting").boolean();
+  c.placement = {jc.at("x").number(), jc.at("y").number(), jc.at("theta").number()};
+  return c;
+}
+
+json configurationToJson(const Configuration& q) {
+  const Eigen::Quaterniond o = q.base_orientation.normalized();
+  return {{"base_position", vec(q.base_position)},
+          {"base_orientation", json::array({o.w(), o.x(), o.y(), o.z()})},
+          {"joints", std::vector<double>(q.joints.data(), q.joints.data() + q.joints.size())}};
+}
+
+Configuration configurationFromJson(const J& jq, const Scenario& sc) {
+  Configuration q;
+  q.base_position = jq.at("base_position").vec3();
+  const auto o = jq.at("base_orientation").numbers(4);
+  q.base_orientation = Eigen::Quaterniond(o[0], o[1], o[2], o[3]);
+  if (std::abs(q.base_orientation.norm() - 1) > 1e-6) jq.at("base_orientation").fail("a unit quaternion [w, x, y, z]");
+  const auto jv = jq.at("joints").numbers(sc.robot->numJoints());
+  q.joints = Eigen::Map<const Eigen::VectorXd>(jv.data(), jv.size());
+  return q;
+}
+
+void checkJointNames(const J& names, const Scenario& sc) {
+  if (names.size() != static_cast<std::size_t>(sc.robot->numJoints()))
+    names.fail("the robot's " + std::to_string(sc.robot->numJoints()) + " joint names");
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names.item(i).string() != sc.robot->joints()[i].name)
+      names.item(i).fail("'" + sc.robot->joints()[i].name + "' (the robot's controller order)");
+}
+
+}  // namespace json_field
 
 std::string planToJson(const Plan& plan, const Scenario& sc) {
   json j;
@@ -77,13 +83,7 @@ std::string planToJson(const Plan& plan, const Scenario& sc) {
     json js;
     js["contacts"] = json::array();
     for (const auto& c : s.contacts) {
-      json jc;
-      jc["spot"] = sc.robot->spots()[c.spec.spot].name;
-      jc["surface"] = sc.scene->surfaces()[c.spec.surface].name;
-      jc["supporting"] = c.spec.supporting;
-      jc["x"] = c.spec.placement.x;
-      jc["y"] = c.spec.placement.y;
-      jc["theta"] = c.spec.placement.theta;
+      json jc = json_field::specToJson(c.spec, sc);
       jc["position"] = vec(c.frame.translation());
       const Eigen::Quaterniond q(c.frame.linear());
       jc["orientation"] = json::array({q.w(), q.x(), q.y(), q.z()});
@@ -93,11 +93,7 @@ std::string planToJson(const Plan& plan, const Scenario& sc) {
       for (const auto& f : c.forces) jc["forces"].push_back(vec(f));
       js["contacts"].push_back(jc);
     }
-    const Configuration& q = s.configuration;
-    const Eigen::Quaterniond o = q.base_orientation.normalized();
-    js["configuration"] = {{"base_position", vec(q.base_position)},
-                           {"base_orientation", json::array({o.w(), o.x(), o.y(), o.z()})},
-                           {"joints", std::vector<double>(q.joints.data(), q.joints.data() + q.joints.size())}};
+    js["configuration"] = json_field::configurationToJson(s.configuration);
     js["potential"] = s.potential;
     j["stances"].push_back(js);
   }
@@ -141,11 +137,7 @@ Plan planFromJson(const std::string& text, const std::string& origin, const Scen
   Plan plan;
   plan.scenario = root.has("scenario") ? root.at("scenario").string() : "";
   plan.robot = root.has("robot") ? root.at("robot").string() : "";
-  const J names = root.at("joint_names");
-  if (names.size() != static_cast<std::size_t>(sc.robot->numJoints())) names.fail("the robot's 30 joint names");
-  for (std::size_t i = 0; i < names.size(); ++i)
-    if (names.item(i).string() != sc.robot->joints()[i].name)
-      names.item(i).fail("'" + sc.robot->joints()[i].name + "' (the robot's controller order)");
+  json_field::checkJointNames(root.at("joint_names"), sc);
   const J stances = root.at("stances");
   for (std::size_t si = 0; si < stances.size(); ++si) {
     const J js = stances.item(si);
@@ -154,12 +146,7 @@ Plan planFromJson(const std::string& text, const std::string& origin, const Scen
     for (std::size_t ci = 0; ci < contacts.size(); ++ci) {
       const J jc = contacts.item(ci);
       PlanContact c;
-      c.spec.spot = sc.robot->spotIndex(jc.at("spot").string());
-      if (c.spec.spot < 0) jc.at("spot").fail("a contact spot of the robot");
-      c.spec.surface = sc.scene->surfaceIndex(jc.at("surface").string());
-      if (c.spec.surface < 0) jc.at("surface").fail("a surface of the scene");
-      c.spec.supporting = jc.at("supporting").boolean();
-      c.spec.placement = {jc.at("x").number(), jc.at("y").number(), jc.at("theta").number()};
+      c.spec = json_field::specFromJson(jc, sc);
       c.frame = contactFrame(sc.scene->surfaces()[c.spec.surface], c.spec.placement);
       if (jc.has("points")) {
         const J pts = jc.at("points"), fs = jc.at("forces");
@@ -171,14 +158,7 @@ Plan planFromJson(const std::string& text, const std::string& origin, const Scen
       }
       st.contacts.push_back(c);
     }
-    const J jq = js.at("configuration");
-    st.configuration.base_position = jq.at("base_position").vec3();
-    const auto o = jq.at("base_orientation").numbers(4);
-    st.configuration.base_orientation = Eigen::Quaterniond(o[0], o[1], o[2], o[3]);
-    if (std::abs(st.configuration.base_orientation.norm() - 1) > 1e-6)
-      jq.at("base_orientation").fail("a unit quaternion [w, x, y, z]");
-    const auto jv = jq.at("joints").numbers(sc.robot->numJoints());
-    st.configuration.joints = Eigen::Map<const Eigen::VectorXd>(jv.data(), jv.size());
+    st.configuration = json_field::configurationFromJson(js.at("configuration"), sc);
     st.potential = js.has("potential") ? js.at("potential").number() : 0.0;
     plan.stances.push_back(st);
   }
