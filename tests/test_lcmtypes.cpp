@@ -168,6 +168,7 @@ TEST(LcmTypes, TrajectoryWithPhases) {
   t.num_samples = 5;
   for (int i = 0; i < 5; ++i) {
     t.t.push_back(i * 0.005);
+    t.phase.push_back(0);
     t.base_position.push_back({0, 0, 0.6});
     t.base_orientation.push_back({1, 0, 0, 0});
     t.joints.push_back({0.1 * i, 0, 0});
@@ -181,6 +182,10 @@ TEST(LcmTypes, TrajectoryWithPhases) {
   ph.spots = {"r_sole", "l_sole"};
   ph.surfaces = {"floor", "floor"};
   ph.supporting = {true, true};
+  ph.x = {0.0, 0.0};
+  ph.y = {-0.1, 0.1};
+  ph.theta = {0.0, 0.0};
+  ph.stance = 0;
   t.num_phases = 1;
   t.phases = {ph};
   auto o = roundTrip(t);

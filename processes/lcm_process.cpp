@@ -1,0 +1,127 @@
+#include "processes/lcm_process.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <stdexcept>
+
+#include "lcmtypes/channels.hpp"
+
+namespace acyclic::proc {
+
+namespace {
+std::atomic<bool> g_stop{false};
+void onSignal(int) { g_stop = true; }
+}  // namespace
+
+std::string defaultLcmUrl() {
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  return env && *env ? env : "";
+}
+
+void installSignalHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+bool stopRequested() { return g_stop.load(); }
+const std::atomic<bool>& stopFlag() { return g_stop; }
+
+std::int64_t nowMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+void log(const std::string& process, const std::string& message) {
+  const std::time_t t = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%H:%M:%S", std::localtime(&t));
+  std::fprintf(stderr, "%s %s[%d]: %s\n", stamp, process.c_str(), static_cast<int>(getpid()), message.c_str());
+  std::fflush(stderr);
+}
+
+Bus::Bus(const std::string& url) : lcm_(url) {
+  if (!lcm_.good()) throw std::runtime_error("LCM could not start on '" + url + "'" +
+                                             (url.rfind("udpm", 0) == 0 || url.empty()
+                                                  ? " (udpm needs a multicast route: see the README)"
+                                                  : ""));
+}
+
+StatusReporter::StatusReporter(Bus& bus, std::string process) : bus_(bus) {
+  msg_.process = std::move(process);
+  msg_.pid = getpid();
+  msg_.request_id = -1;
+  msg_.state = process_status_t::IDLE;
+  publish();
+}
+
+void StatusReporter::publish() {
+  msg_.utime = nowMicros();
+  msg_.requests_served = served_;
+  msg_.errors = errors_;
+  last_publish_us_ = msg_.utime;
+  bus_.publish(channels::kStatus, msg_);
+}
+
+void StatusReporter::idle() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  msg_.state = process_status_t::IDLE;
+  msg_.request_id = -1;
+  msg_.reason.clear();
+  publish();
+}
+
+void StatusReporter::busy(std::int64_t request_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  msg_.state = process_status_t::BUSY;
+  msg_.request_id = request_id;
+  msg_.reason.clear();
+  publish();
+}
+
+void StatusReporter::error(std::int64_t request_id, const std::string& reason) {
+  log(msg_.process, "error" + (request_id >= 0 ? " (request " + std::to_string(request_id) + ")" : std::string()) +
+                        ": " + reason);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++errors_;
+  // An error is reported on its own message; the state the process is in
+  // (idle or busy with another request) comes back with the next one.
+  process_status_t e = msg_;
+  e.state = process_status_t::ERROR;
+  e.request_id = request_id;
+  e.reason = reason;
+  e.utime = nowMicros();
+  e.requests_served = served_;
+  e.errors = errors_;
+  bus_.publish(channels::kStatus, e);
+}
+
+void StatusReporter::stopping() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  msg_.state = process_status_t::STOPPING;
+  msg_.reason = "signal";
+  publish();
+}
+
+void StatusReporter::tick() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (nowMicros() - last_publish_us_ >= 1000000) publish();
+}
+
+int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<bool()>& done, int period_ms) {
+  while (!stopRequested() && !(done && done())) {
+    // handleTimeout returns < 0 on error (and, in LCM 1.3.1, when interrupted
+    // by a signal: then the stop flag is set and the loop ends).
+    if (bus.lcm().handleTimeout(period_ms) < 0 && !stopRequested()) return 1;
+    if (on_tick) on_tick();
+  }
+  return 0;
+}
+
+}  // namespace acyclic::proc
