@@ -1,0 +1,44 @@
+#include "hrp2_bridge/periodic_loop.h"
+
+#include <cerrno>
+#include <cmath>
+#include <stdexcept>
+
+namespace acyclic::hrp2 {
+
+namespace {
+std::int64_t toNs(const timespec& t) { return std::int64_t(t.tv_sec) * 1000000000LL + t.tv_nsec; }
+timespec fromNs(std::int64_t ns) { return timespec{time_t(ns / 1000000000LL), long(ns % 1000000000LL)}; }
+}  // namespace
+
+std::int64_t monotonicMicros() {
+  timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return toNs(t) / 1000;
+}
+
+PeriodicLoop::PeriodicLoop(double period_s) : period_ns_(std::llround(period_s * 1e9)) {
+  if (period_ns_ <= 0) throw std::invalid_argument("PeriodicLoop: the period must be positive");
+  clock_gettime(CLOCK_MONOTONIC, &next_);
+}
+
+std::int64_t PeriodicLoop::wait() {
+  std::int64_t next = toNs(next_) + period_ns_;
+  timespec now;
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  // More than a period behind: skip to the next future deadline rather than
+  // firing a burst of catch-up periods.
+  if (toNs(now) - next > period_ns_) {
+    const std::int64_t missed = (toNs(now) - next) / period_ns_;
+    skipped_ += missed;
+    next += missed * period_ns_;
+  }
+  next_ = fromNs(next);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next_, nullptr) == EINTR) {
+  }
+  return monotonicMicros();
+}
+
+std::int64_t PeriodicLoop::deadline() const { return toNs(next_) / 1000; }
+
+}  // namespace acyclic::hrp2

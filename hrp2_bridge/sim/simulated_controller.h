@@ -1,0 +1,94 @@
+#pragma once
+// A simulated HRP-2 controller (no LCM, no clock: `now` in microseconds is
+// passed in): position-controlled joints that track the latest command with
+// a first-order law and velocity feed-forward, within the model's velocity
+// limits; the base follows the streamed waist reference with the same law;
+// contact forces from the quasi-static model at the contacts found
+// geometrically (contact_forces.h). Fault options: latency, dropped
+// commands, a freeze (the controller hangs: no motion, no state).
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hrp2_bridge/sim/contact_forces.h"
+#include "planner/scene/scenario.h"
+
+namespace acyclic::hrp2 {
+
+struct SimOptions {
+  double dt = 0.005;               // s, controller period
+  double time_constant = 0.02;     // s, first-order joint tracking
+  double latency = 0;              // s, a command is applied this long after it arrives
+  double drop_rate = 0;            // fraction of commands lost (seeded: deterministic)
+  std::uint64_t seed = 1;
+  double freeze_after = -1;        // s after the first command the controller hangs; < 0: never
+  int wrench_every = 10;           // contact forces every this many periods (the LP is the costly part)
+  bool servo_on = true;
+  void validate() const;           // std::invalid_argument naming the bad value
+};
+
+struct SimCommand {
+  std::int64_t request_id = -1, sequence = -1;
+  int mode = 0;                    // 0 stream, 1 hold, 2 freeze (hrp2_command_t)
+  Eigen::VectorXd q, dq;
+  Eigen::Vector3d waist_position = Eigen::Vector3d::Zero(), waist_rpy = Eigen::Vector3d::Zero();
+  bool stabilizer = true;
+};
+
+struct SimState {
+  std::int64_t request_id = -1, command_sequence = -1;
+  Eigen::VectorXd q, dq;
+  Configuration configuration;     // base pose and joints
+  std::vector<ContactWrench> wrenches;
+  bool equilibrium = false;        // the quasi-static LP found forces
+  bool servo_on = true, stabilizer = true;
+};
+
+class SimulatedController {
+ public:
+  SimulatedController(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                      const Configuration& start, SimOptions options);
+
+  // A command arrives (dropped or delayed as the options say). A command of
+  // the wrong size or not finite is ignored and counted: a real controller
+  // would refuse it too.
+  void receive(const SimCommand& c, std::int64_t now);
+  // Advances to `now`: applies the commands that are due, integrates the
+  // tracking law (sub-steps of at most dt).
+  void step(std::int64_t now);
+  // True once the freeze time has passed: no motion, no state.
+  bool frozen(std::int64_t now) const;
+  SimState state();
+
+  long received() const { return received_; }
+  long dropped() const { return dropped_; }
+  long rejected() const { return rejected_; }
+  long applied() const { return applied_; }
+
+ private:
+  void apply(const SimCommand& c);
+  void integrate(double h);
+
+  std::shared_ptr<const RobotModel> robot_;
+  SimOptions opt_;
+  ContactForces forces_;
+  Configuration q_;
+  Eigen::VectorXd dq_;
+  Eigen::VectorXd vmax_;
+  std::deque<std::pair<std::int64_t, SimCommand>> pending_;  // due time, command
+  SimCommand current_;
+  bool has_command_ = false;
+  std::int64_t first_command_at_ = -1, last_step_ = -1;
+  std::mt19937_64 rng_;
+  long received_ = 0, dropped_ = 0, rejected_ = 0, applied_ = 0;
+  long states_ = 0;
+  std::vector<ContactWrench> wrenches_;
+  bool equilibrium_ = false;
+};
+
+}  // namespace acyclic::hrp2
