@@ -186,6 +186,7 @@ void Bridge::endCheck(std::int64_t request_id, PrepareResult result, std::int64_
   traj_ = std::move(result.prepared);
   request_id_ = request_id;
   tau_ = 0;
+  pos_ = 0;
   active_ = true;
   blend_start_ = -1;
   stream_start_ = now;
@@ -230,14 +231,18 @@ Command Bridge::streamCommand(std::int64_t now) {
       rate = u * u * (3 - 2 * u);
     }
   }
-  if (first_stream_seq_ >= 0) tau_ += rate * cfg_.dt;  // the first command is the first sample
+  // Playback position counted in samples (exact while the rate is 1), so
+  // that plain playback sends the prepared samples bit for bit.
+  if (first_stream_seq_ >= 0) pos_ += rate;
   const auto& s = traj_.samples;
-  const double d = traj_.duration();
-  const bool last = tau_ >= d - 1e-9;
-  const double tau = std::min(tau_, d);
-  const std::size_t k = std::min(s.size() - 1, static_cast<std::size_t>(std::floor(tau / traj_.dt + 1e-9)));
+  const double last_pos = double(s.size() - 1);
+  const bool last = pos_ >= last_pos - 1e-9;
+  const double pos = std::min(pos_, last_pos);
+  const std::size_t k = std::min(s.size() - 1, static_cast<std::size_t>(std::floor(pos + 1e-9)));
   const std::size_t k1 = std::min(s.size() - 1, k + 1);
-  const double u = k1 == k ? 0.0 : std::clamp(tau / traj_.dt - double(k), 0.0, 1.0);
+  const double u = k1 == k ? 0.0 : std::clamp(pos - double(k), 0.0, 1.0);
+  tau_ = pos * traj_.dt;
+  const double d = traj_.duration();
   Command c;
   c.utime = now;
   c.request_id = request_id_;

@@ -131,6 +131,7 @@ class Bridge {
   std::int64_t request_id_ = -1, checking_id_ = -1;
   BridgeState before_check_ = BridgeState::Idle;
   double tau_ = 0;                        // s of trajectory played
+  double pos_ = 0;                        // the same in samples
   bool active_ = false;                   // a trajectory is under way (streaming or interrupted by an e-stop)
   std::int64_t blend_start_ = -1;         // e-stop release: speed ramp start
   std::int64_t stream_start_ = 0;
