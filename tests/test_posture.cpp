@@ -142,6 +142,89 @@ TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
   EXPECT_LT(block(nq + 3, nx - nq - 3, 0, nq), 1e-6) << "forces x configuration";
 }
 
+// The chair's start stance with the left wrist held at a world pose (the
+// interpolator's moving body): its current pose raised and turned a little.
+PostureRequest wristAtPose(const Scenario& sc) {
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  PoseTarget t;
+  t.spot = sc.robot->spotIndex("l_wrist");
+  t.pose = k.spotPose(t.spot);
+  t.pose.translation() += Eigen::Vector3d(0.02, -0.01, 0.03);
+  t.pose.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d(1, 2, 0).normalized()).toRotationMatrix() * t.pose.linear();
+  r.pose_target = t;
+  return r;
+}
+
+TEST(PostureProblem, PoseTargetRowsMatchFiniteDifferences) {
+  const Scenario& sc = chair();
+  auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
+  PostureProblem p(sc.robot, sc.scene, cm, wristAtPose(sc), {});
+  // 4 contacts, then the pose target's 6 rows.
+  ASSERT_EQ(p.contactRows(), 6 * 5);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, 0.05);
+  Eigen::VectorXd x = p.initialPoint();
+  for (int i = 0; i < sc.robot->tangentSize(); ++i)
+    if (i < 3 || i >= 6) x[i] += n(rng);  // base rotation at the guess (see the Hessian test)
+  const Eigen::MatrixXd J = p.constraintJacobian(x);
+  const Eigen::VectorXd g0 = p.constraints(x);
+  EXPECT_GT(g0.segment(24, 6).norm(), 1e-3);  // the target is not met at the guess
+  Eigen::MatrixXd Jn(J.rows(), J.cols());
+  for (int i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd a = x, b = x;
+    a[i] += 1e-6;
+    b[i] -= 1e-6;
+    Jn.col(i) = (p.constraints(a) - p.constraints(b)) / 2e-6;
+  }
+  EXPECT_LT(test::relativeError(J.middleRows(24, 6), Jn.middleRows(24, 6)), 1e-6) << "pose target rows";
+  std::set<std::pair<int, int>> s(p.jacobianStructure().begin(), p.jacobianStructure().end());
+  for (int r = 24; r < 30; ++r)
+    for (int c = 0; c < J.cols(); ++c)
+      if (std::abs(Jn(r, c)) > 1e-7) {
+        EXPECT_TRUE(s.count({r, c})) << "row " << r << " col " << c;
+      }
+  // Its curvature in the Lagrangian's Hessian, multipliers on its rows only.
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(p.numConstraints());
+  for (int r = 24; r < 30; ++r) y[r] = 10 * n(rng);
+  const Eigen::MatrixXd H = p.lagrangianHessian(x, 0.0, y);
+  Eigen::MatrixXd Hn(x.size(), x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd a = x, b = x;
+    a[i] += 1e-6;
+    b[i] -= 1e-6;
+    const Eigen::VectorXd ga = p.constraintJacobian(a).transpose() * y;
+    const Eigen::VectorXd gb = p.constraintJacobian(b).transpose() * y;
+    Hn.col(i) = (ga - gb) / 2e-6;
+  }
+  const int nq = sc.robot->tangentSize();
+  EXPECT_LT(test::relativeError(H.block(6, 6, nq - 6, nq - 6), Hn.block(6, 6, nq - 6, nq - 6)), 1e-6);
+  EXPECT_LT(test::relativeError(H.block(0, 0, 3, nq), Hn.block(0, 0, 3, nq)), 1e-6);
+}
+
+TEST(PostureGenerator, PoseTargetIsReached) {
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  const PostureRequest r = wristAtPose(sc);
+  const PostureResult res = pg.solve(r);
+  ASSERT_TRUE(res.success()) << toString(res.status) << ": " << res.reason;
+  Kinematics k(sc.robot);
+  k.setConfiguration(res.configuration);
+  const Eigen::Isometry3d at = k.spotPose(r.pose_target->spot);
+  EXPECT_LT((at.translation() - r.pose_target->pose.translation()).norm(), 1e-5);
+  EXPECT_LT(Eigen::AngleAxisd(at.linear().transpose() * r.pose_target->pose.linear()).angle(), 1e-4);
+  expectValid(sc, res, sc.start_stance);
+  // A pose target on a spot that is also in a contact is refused with a reason.
+  PostureRequest bad = r;
+  bad.pose_target->spot = sc.robot->spotIndex("r_sole");
+  const PostureResult b = pg.solve(bad);
+  EXPECT_EQ(b.status, PostureResult::Status::BadInput);
+  EXPECT_NE(b.reason.find("r_sole"), std::string::npos) << b.reason;
+}
+
 TEST(PostureProblem, StaticsRowsAreSimbodysGravityTorques) {
   // With no contact force the joint rows are Simbody's g(q) / weight.
   const Scenario& sc = chair();

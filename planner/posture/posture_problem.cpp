@@ -77,6 +77,17 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
     if (!(req_.floating->volume.theta_min <= req_.floating->volume.theta_max))
       throw std::invalid_argument("search volume: theta_min > theta_max");
   }
+  if (req_.pose_target) {
+    const PoseTarget& t = *req_.pose_target;
+    if (t.spot < 0 || t.spot >= static_cast<int>(robot_->spots().size())) throw std::invalid_argument("unknown spot");
+    if (!spots.insert(t.spot).second)
+      throw std::invalid_argument("spot " + robot_->spots()[t.spot].name + " is in a contact and a pose target");
+    if (!t.pose.matrix().allFinite()) throw std::invalid_argument("pose target has a non-finite value");
+    for (int o : t.touch_obstacles) {
+      if (o < 0 || o >= static_cast<int>(scene_->obstacles().size())) throw std::invalid_argument("unknown obstacle");
+      allowed_touch_.push_back({robot_->spots()[t.spot].link, o});
+    }
+  }
 
   nq_ = robot_->tangentSize();
   int nx = nq_;
@@ -124,7 +135,7 @@ void PostureProblem::addCollisionPairs(const std::vector<int>& pairs) {
 }
 
 void PostureProblem::layout() {
-  const int n_contacts = static_cast<int>(req_.contacts.size()) + (req_.floating ? 1 : 0);
+  const int n_contacts = numContacts();
   row_floating_ = 6 * n_contacts;
   n_float_rows_ = 0;
   if (req_.floating) {
@@ -147,10 +158,9 @@ void PostureProblem::layout() {
       if (mask[c]) structure_.push_back({row, c});
   };
   for (int ci = 0; ci < n_contacts; ++ci) {
-    const bool floating = ci == static_cast<int>(req_.contacts.size());
-    const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
+    const bool floating = req_.floating && ci == static_cast<int>(req_.contacts.size());
     std::vector<bool> mask(nx_, false);
-    linkCols(robot_->spots()[spot].link, mask);
+    linkCols(robot_->spots()[spotOf(ci)].link, mask);
     if (floating)
       for (int k = 0; k < 3; ++k) mask[x_float_ + k] = true;
     for (int r = 0; r < 6; ++r) emit(6 * ci + r, mask);
@@ -491,9 +501,19 @@ std::vector<PostureProblem::ContactForces> PostureProblem::forcesAt(const Eigen:
   return out;
 }
 
+int PostureProblem::spotOf(int ci) const {
+  const int nc = static_cast<int>(req_.contacts.size());
+  if (ci < nc) return req_.contacts[ci].spot;
+  if (req_.floating && ci == nc) return req_.floating->spot;
+  return req_.pose_target->spot;
+}
+
 PostureProblem::ContactGeometry PostureProblem::contactGeometry(int ci, const Eigen::VectorXd& x) const {
-  const bool floating = ci == static_cast<int>(req_.contacts.size());
-  const int spot = floating ? req_.floating->spot : req_.contacts[ci].spot;
+  const int nc = static_cast<int>(req_.contacts.size());
+  const int spot = spotOf(ci);
+  if (ci >= nc + (req_.floating ? 1 : 0))  // the pose target: a world frame, no surface
+    return {false, robot_->spots()[spot].link, kin_.spotPose(spot), req_.pose_target->pose};
+  const bool floating = ci == nc;
   const Surface& surf = scene_->surfaces()[floating ? req_.floating->surface : req_.contacts[ci].surface];
   const SurfacePlacement pl = floating ? floatingAt(x) : req_.contacts[ci].placement;
   return {floating, robot_->spots()[spot].link, kin_.spotPose(spot), contactFrame(surf, pl)};

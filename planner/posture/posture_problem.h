@@ -8,7 +8,8 @@
 // corner of each supporting contact, in units of the robot's weight ].
 //
 // Constraints (rows, in this order):
-//   contacts    6 per contact: spot origin on its target point (3); spot z
+//   contacts    6 per contact (the fixed ones, the floating one, then the pose
+//               target if any): spot origin on its target point (3); spot z
 //               along the surface normal (2: z_s . x_t = z_s . y_t = 0); in-plane
 //               angle (1: x_s . y_t = 0)
 //   floating    (x, y) inside the search polygon; each spot-polygon corner
@@ -44,9 +45,21 @@ struct FloatingContact {
   SearchVolume volume;
 };
 
+// A spot's frame held at a world pose, with no surface (the interpolator's
+// moving body): 6 rows like a contact's (origin on the pose's origin, z along
+// its z, x orthogonal to its y). Geometric only.
+struct PoseTarget {
+  int spot = -1;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  // Obstacles the spot's link may touch (the surfaces it leaves or reaches:
+  // near them its pose, not a collision margin, keeps it clear).
+  std::vector<int> touch_obstacles;
+};
+
 struct PostureRequest {
   std::vector<ContactSpec> contacts;        // fixed contacts (placement given)
   std::optional<FloatingContact> floating;  // at most one, geometric only
+  std::optional<PoseTarget> pose_target;    // at most one; rows after the floating contact's
   Configuration initial_guess;
   std::shared_ptr<const PostureCost> cost;  // default: distance to the initial guess
 };
@@ -130,8 +143,11 @@ class PostureProblem {
     int link;
     Eigen::Isometry3d spot, target;
   };
-  int numContacts() const { return static_cast<int>(req_.contacts.size()) + (req_.floating ? 1 : 0); }
+  int numContacts() const {
+    return static_cast<int>(req_.contacts.size()) + (req_.floating ? 1 : 0) + (req_.pose_target ? 1 : 0);
+  }
   ContactGeometry contactGeometry(int ci, const Eigen::VectorXd& x) const;
+  int spotOf(int ci) const;  // the spot of contact row block ci
   void layout();
   void evaluate(const Eigen::VectorXd& x);
   Eigen::Matrix3d leftJacobian(const Eigen::Vector3d& w) const;
