@@ -1,11 +1,13 @@
-// acyclic-check: checks a scenario's start stance, or a plan, against the
-// validity contract (DESIGN.md section 9) and prints every check with its
-// figures. Exit status: 0 valid, 1 a violation, 2 bad input.
+// acyclic-check: checks a scenario's start stance, a plan, or a trajectory
+// against the validity contract (DESIGN.md section 9) and prints every check
+// with its figures. Exit status: 0 valid, 1 a violation, 2 bad input.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <unistd.h>
 
 #include "planner/check/plan_check.h"
+#include "planner/check/trajectory_check.h"
 #include "planner/common/format_error.h"
 #include "planner/scene/scenario.h"
 
@@ -31,12 +33,17 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Checks a scenario's start stance, or a plan, against Acyclic's validity contract (DESIGN.md\n"
       "section 9): joint limits, contacts, collisions and quasi-static equilibrium for every posture;\n"
-      "for a plan also the sequence (start stance first, goal met last, one contact change per step).\n"
+      "for a plan also the sequence (start stance first, goal met last, one contact change per step);\n"
+      "for a trajectory every sample with its phase's contacts (held within 1 mm), the joint velocity\n"
+      "limits (stored and finite-difference), zero velocity where a contact is made or broken.\n"
       "Exit status: 0 valid, 1 a violation, 2 bad input."};
-  std::string scenario_path, plan_path;
+  std::string scenario_path, plan_path, trajectory_path;
   bool verbose = false;
   app.add_option("scenario", scenario_path, "scenario file (format acyclic.scenario/1)")->required();
   app.add_option("--plan", plan_path, "plan file (format acyclic.plan/1) to check against the scenario");
+  app.add_option("--trajectory", trajectory_path,
+                 "trajectory file (format acyclic.trajectory/1) to check against the scenario, sample by sample")
+      ->excludes("--plan");
   app.add_flag("-v,--verbose", verbose, "print every check of every stance, not only the failing ones");
   CLI11_PARSE(app, argc, argv);
 
@@ -48,6 +55,26 @@ int main(int argc, char** argv) {
     std::printf("  scene %s: %zu obstacles, %zu contact surfaces\n", sc.scene->path().c_str(),
                 sc.scene->obstacles().size(), sc.scene->surfaces().size());
     acyclic::ValidityChecker checker(sc.robot, sc.scene);
+
+    if (!trajectory_path.empty()) {
+      const acyclic::Trajectory tr = acyclic::readTrajectory(trajectory_path, sc);
+      std::printf("trajectory %s: %zu samples, %zu phases, %.3f s\n", trajectory_path.c_str(), tr.samples.size(),
+                  tr.phases.size(), tr.duration());
+      const bool tty = isatty(STDERR_FILENO);
+      auto progress = [&](int done, int total) {
+        if (tty) std::fprintf(stderr, "\r  checking sample %d of %d ", done, total);
+      };
+      const acyclic::TrajectoryReport rep = acyclic::checkTrajectory(tr, sc, checker, {}, progress);
+      if (tty) std::fprintf(stderr, "\n");
+      for (const auto& p : rep.parts) {
+        std::printf("  [%s] %-23s %s\n", p.ok() ? " ok " : "FAIL", p.name.c_str(), p.summary.c_str());
+        for (const auto& v : p.violations) std::printf("         violation: %s\n", v.c_str());
+        if (p.violation_count > static_cast<long>(p.violations.size()))
+          std::printf("         ... %ld violations in all\n", p.violation_count);
+      }
+      std::printf("%s\n", rep.valid() ? "trajectory: valid" : "trajectory: INVALID");
+      return rep.valid() ? 0 : 1;
+    }
 
     if (plan_path.empty()) {
       std::printf("start stance: %s\n", describeStance(sc, sc.start_stance).c_str());
