@@ -1,0 +1,48 @@
+#pragma once
+// The moving body's path between two stances (DESIGN.md section 10): straight
+// along the surface normal where it leaves a surface and where it reaches one,
+// a C1 cubic spline between (through raised via-points after a repair), the
+// orientation held on the straight parts (a sole stays flat near the floor)
+// and slerped along the spline. Parameterized by arc length, s in [0, 1].
+#include <optional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace acyclic {
+
+struct BodyPathEnd {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the spot's world frame
+  std::optional<Eigen::Vector3d> normal;  // outward surface normal when the end is on a surface
+};
+
+class BodyPath {
+ public:
+  // `lift`: length of each straight part; `vias`: points the spline passes through.
+  BodyPath(BodyPathEnd from, BodyPathEnd to, double lift, std::vector<Eigen::Vector3d> vias = {});
+
+  double length() const { return lift0_ + curve_length_ + lift1_; }
+  Eigen::Isometry3d pose(double s) const;
+  // The parameter at which the body is `clearance` off its start (end) surface
+  // along the normal; 0 (1) when that end is not on a surface.
+  double leaveParameter(double clearance) const;
+  double arriveParameter(double clearance) const;
+
+  // The same ends with one via-point `height` above the middle of the spline
+  // (along the mean of the end normals, or world z): a repair that raises the
+  // path away from what it collides with.
+  BodyPath raised(double height) const;
+  const std::vector<Eigen::Vector3d>& vias() const { return vias_; }
+
+ private:
+  Eigen::Vector3d curvePoint(double u) const;  // u in [0, number of spline segments]
+  BodyPathEnd from_, to_;
+  double lift_;
+  double lift0_ = 0, lift1_ = 0;
+  std::vector<Eigen::Vector3d> vias_;
+  std::vector<Eigen::Vector3d> points_, tangents_;  // spline knots and their tangents
+  std::vector<double> table_u_, table_len_;         // arc-length table of the spline
+  double curve_length_ = 0;
+};
+
+}  // namespace acyclic

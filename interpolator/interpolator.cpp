@@ -1,0 +1,192 @@
+#include "interpolator/interpolator.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "interpolator/stance_filter.h"
+#include "interpolator/time_law.h"
+
+namespace acyclic {
+
+const char* toString(InterpolationResult::Status s) {
+  switch (s) {
+    case InterpolationResult::Status::Success: return "success";
+    case InterpolationResult::Status::InvalidInput: return "invalid input";
+    case InterpolationResult::Status::Unrepairable: return "unrepairable transition";
+    case InterpolationResult::Status::TransitionFailed: return "transition failed";
+    case InterpolationResult::Status::Cancelled: return "cancelled";
+  }
+  return "?";
+}
+
+namespace {
+
+bool sameContacts(const std::vector<ContactSpec>& a, const std::vector<ContactSpec>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].spot != b[i].spot || a[i].surface != b[i].surface || a[i].supporting != b[i].supporting ||
+        a[i].placement.x != b[i].placement.x || a[i].placement.y != b[i].placement.y ||
+        a[i].placement.theta != b[i].placement.theta)
+      return false;
+  return true;
+}
+
+std::string validateOptions(const InterpolatorOptions& o) {
+  if (o.steps < 1) return "steps must be at least 1";
+  if (!(o.dt > 0)) return "dt must be positive";
+  if (!(o.speed_cap > 0)) return "the speed cap must be positive";
+  if (!(o.velocity_share > 0 && o.velocity_share <= 1)) return "the velocity share must be in (0, 1]";
+  if (!(o.lift > o.touch_clearance && o.touch_clearance > 0 && o.touch_clearance < 1e-3))
+    return "expected 0 < touch clearance < 1 mm and lift > touch clearance";
+  if (o.repair_attempts < 0 || !(o.repair_step > 0) || o.refine_depth < 0 || o.posture_iterations < 1)
+    return "repair attempts, refinement depth and posture iterations must be non-negative, the repair step positive";
+  return "";
+}
+
+}  // namespace
+
+InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& opt,
+                                const std::function<void(const InterpolationProgress&)>& progress,
+                                const std::atomic<bool>* cancel) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  InterpolationResult res;
+  using Status = InterpolationResult::Status;
+  auto fail = [&](Status s, std::string why) {
+    res.status = s;
+    res.reason = std::move(why);
+    res.trajectory = Trajectory{};
+    return res;
+  };
+  if (std::string why = validateOptions(opt); !why.empty()) return fail(Status::InvalidInput, why);
+  if (plan.stances.empty()) return fail(Status::InvalidInput, "the plan has no stance");
+  {
+    // Every witness must itself be valid: the interpolation starts and ends on them.
+    ValidityChecker checker(sc.robot, sc.scene);
+    for (std::size_t k = 0; k < plan.stances.size(); ++k) {
+      if (plan.stances[k].configuration.joints.size() != sc.robot->numJoints())
+        return fail(Status::InvalidInput, "stance " + std::to_string(k) + ": the configuration has " +
+                                              std::to_string(plan.stances[k].configuration.joints.size()) + " joints");
+      const ValidityReport r = checker.checkPosture(plan.stances[k].configuration, plan.stances[k].specs());
+      for (const auto& p : r.parts)
+        if (p.checked && !p.ok())
+          return fail(Status::InvalidInput,
+                      "stance " + std::to_string(k) + "'s witness posture is not valid: " + p.name + ": " + p.violations[0]);
+    }
+  }
+
+  TransitionOptions to;
+  to.steps = opt.steps;
+  to.lift = opt.lift;
+  to.touch_clearance = opt.touch_clearance;
+  to.repair_attempts = opt.repair_attempts;
+  to.repair_step = opt.repair_step;
+  to.refine_depth = opt.refine_depth;
+  to.posture.max_iterations = opt.posture_iterations;
+  to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
+  to.posture.problem.collision_cutoff = opt.collision_cutoff;
+  TransitionSolver solver(sc, to);
+  Trajectory& tr = res.trajectory;
+  tr.scenario = plan.scenario;
+  tr.dt = opt.dt;
+  tr.stats.stances_in = static_cast<int>(plan.stances.size());
+
+  InterpolationProgress pr;
+  auto report = [&](const char* stage) {
+    pr.stage = stage;
+    pr.posture_calls = tr.stats.posture_calls;
+    pr.seconds = elapsed();
+    if (progress) progress(pr);
+  };
+
+  FilterResult fr;
+  if (opt.filter) {
+    report("filtering");
+    fr = filterStances(plan, solver, cancel);
+    tr.stats.posture_calls += fr.posture_calls;
+    if (fr.cancelled) return fail(Status::Cancelled, "cancelled while filtering stances");
+  } else {
+    for (int k = 0; k < static_cast<int>(plan.stances.size()); ++k) fr.kept.push_back(k);
+  }
+  res.filtered = fr.dropped;
+  tr.stats.stances_kept = static_cast<int>(fr.kept.size());
+
+  std::vector<TransitionDesign> designs;
+  if (std::string why = designTransitions(plan, fr.kept, designs); !why.empty())
+    return fail(Status::InvalidInput, "the plan's sequence cannot be interpolated: " + why);
+  tr.stats.transitions = static_cast<int>(designs.size());
+  pr.transitions = tr.stats.transitions;
+
+  std::vector<MotionPiece> pieces;
+  for (std::size_t i = 0; i < designs.size(); ++i) {
+    const TransitionDesign& d = designs[i];
+    pr.transition = static_cast<int>(i);
+    report("transitions");
+    if (cancel && cancel->load()) return fail(Status::Cancelled, "cancelled");
+    auto cached = fr.solved.find({d.from, d.to});
+    TransitionOutcome o = cached != fr.solved.end() ? cached->second : solver.solve(plan, d, cancel);
+    if (cached == fr.solved.end()) tr.stats.posture_calls += o.posture_calls;
+    if (o.cancelled) return fail(Status::Cancelled, "cancelled");
+    if (!o.ok) {
+      res.failed_stances = {d.from, d.to};
+      const std::string where = "stances " + std::to_string(d.from) + " -> " + std::to_string(d.to) + ": ";
+      return fail(d.kind == TransitionDesign::Kind::Move ? Status::Unrepairable : Status::TransitionFailed,
+                  where + o.reason);
+    }
+    tr.stats.repairs += o.repaired;
+    res.refinements += o.refinements;
+    for (auto& p : o.pieces) pieces.push_back(std::move(p));
+  }
+  pr.transition = pr.transitions;
+  report("timing");
+
+  // Time each piece rest to rest; consecutive pieces with the same contacts form one phase.
+  TimeLawOptions tl{opt.dt, opt.velocity_share, opt.speed_cap};
+  Kinematics kin(sc.robot);
+  std::vector<TimedPiece> timed;
+  std::vector<int> piece_phase, piece_start;
+  int total = 0;
+  for (const auto& p : pieces) {
+    TimedPiece t(p.knots, *sc.robot, kin, tl);
+    if (t.steps() == 0) continue;  // no motion
+    if (tr.phases.empty() || !sameContacts(tr.phases.back().contacts, p.contacts)) {
+      TrajectoryPhase ph;
+      ph.t_start = total * opt.dt;
+      ph.contacts = p.contacts;
+      ph.stance = p.stance;
+      tr.phases.push_back(ph);
+    }
+    piece_phase.push_back(static_cast<int>(tr.phases.size()) - 1);
+    piece_start.push_back(total);
+    total += t.steps();
+    tr.phases.back().t_end = total * opt.dt;
+    timed.push_back(std::move(t));
+  }
+  if (timed.empty()) {  // nothing moves: one sample at the first witness
+    TrajectoryPhase ph;
+    ph.contacts = plan.stances.front().specs();
+    ph.stance = 0;
+    tr.phases.push_back(ph);
+    TrajectorySample s;
+    s.q = plan.stances.front().configuration;
+    s.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
+    tr.samples.push_back(s);
+  } else {
+    std::size_t p = 0;
+    for (int i = 0; i <= total; ++i) {
+      // A sample on a boundary belongs to the piece that starts there (both are at rest on it).
+      while (p + 1 < timed.size() && i >= piece_start[p + 1]) ++p;
+      TrajectorySample s;
+      s.t = i * opt.dt;
+      s.q = timed[p].at((i - piece_start[p]) * opt.dt, &s.dq);
+      s.phase = piece_phase[p];
+      tr.samples.push_back(std::move(s));
+    }
+  }
+  tr.stats.seconds = elapsed();
+  res.status = Status::Success;
+  report("done");
+  return res;
+}
+
+}  // namespace acyclic

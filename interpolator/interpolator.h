@@ -1,0 +1,59 @@
+#pragma once
+// The trajectory interpolator (DESIGN.md section 10, paper 3.3 and 4): turns a
+// contact plan into a time-parameterized whole-body trajectory at the
+// controller's rate. Stances are filtered (stance_filter.h), each transition
+// is turned into knots (transition.h), and the pieces of constant contacts are
+// timed rest to rest (time_law.h) and sampled every dt. Knows nothing of LCM.
+// Failures return a status with a reason; exceptions are for misuse only.
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "interpolator/transition.h"
+#include "planner/plan/plan.h"
+#include "planner/plan/trajectory.h"
+
+namespace acyclic {
+
+struct InterpolatorOptions {
+  int steps = 20;                // n: posture-generator steps per transition
+  double dt = 0.005;             // s, the controller's period
+  double speed_cap = 0.2;        // m/s, any link origin (quasi-static motion)
+  double velocity_share = 0.9;   // of each joint's velocity limit
+  bool filter = true;            // drop stances whose direct transition is valid
+  double lift = 0.03;            // m: straight along the normal when leaving and reaching a surface
+  double touch_clearance = 5e-4; // m: a body this far off its surface has left it
+  int repair_attempts = 4;       // raised via-points tried on a colliding path
+  double repair_step = 0.05;     // m: via-point height added per attempt
+  int refine_depth = 3;
+  // Each posture call bounded by iterations, not time: same input, same output.
+  int posture_iterations = 100;
+  double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out
+};
+
+struct InterpolationProgress {
+  int transition = 0, transitions = 0;  // done, total
+  long posture_calls = 0;
+  double seconds = 0;
+  std::string stage;                    // "filtering", "transitions", "timing"
+};
+
+struct InterpolationResult {
+  enum class Status { Success, InvalidInput, Unrepairable, TransitionFailed, Cancelled };
+  Status status = Status::InvalidInput;
+  std::string reason;                   // on failure; names the stance indices
+  std::vector<int> failed_stances;      // the transition that failed: from, to
+  Trajectory trajectory;                // on success
+  int filtered = 0;                     // stances dropped
+  int refinements = 0;                  // knots inserted between steps
+  bool success() const { return status == Status::Success; }
+};
+
+const char* toString(InterpolationResult::Status s);
+
+InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& options,
+                                const std::function<void(const InterpolationProgress&)>& progress = {},
+                                const std::atomic<bool>* cancel = nullptr);
+
+}  // namespace acyclic

@@ -1,0 +1,94 @@
+#pragma once
+// One transition of a plan (DESIGN.md section 10): designed from the plan's
+// structure, then turned into knots (witness postures and posture-generator
+// solutions) grouped in pieces of constant contacts.
+//
+// Kinds, from consecutive kept stances a -> b:
+//   Fixed  the same contacts, or one contact's support flipped: every contact
+//          held, the supporting ones those supporting in either stance; knots
+//          at n steps, cost the distance to the linear interpolation of the
+//          two witnesses. No motion at all when the witnesses coincide.
+//   Move   a contact removed, added, or removed and then added again for the
+//          same spot (a -> b -> c merged, the settled stance b giving the
+//          contacts held in the air): the moving body follows a BodyPath from
+//          its pose in the first witness to its pose in the last; at n steps
+//          the posture generator holds the shared contacts and the body on its
+//          path. The body leaves (reaches) a surface in a short piece that
+//          keeps the contact: the phase changes when it is `touch_clearance`
+//          off the surface, where no check can mistake it for a collision.
+// Between knots, the linear interpolation is checked at each segment's middle
+// by the independent validity check and refined where it fails. A Move whose
+// path collides (a knot infeasible, or a middle that refinement cannot fix) is
+// repaired by raising a via-point, higher on each attempt.
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "interpolator/body_path.h"
+#include "planner/check/validity.h"
+#include "planner/plan/plan.h"
+#include "planner/posture/posture_generator.h"
+
+namespace acyclic {
+
+struct TransitionDesign {
+  enum class Kind { Fixed, Move };
+  Kind kind = Kind::Fixed;
+  int from = -1, to = -1;        // plan stance indices
+  int motion_stance = -1;        // the stance whose contacts hold during the motion
+  std::vector<ContactSpec> motion_contacts;
+  int spot = -1;                 // Move: the moving body's spot
+  std::optional<ContactSpec> leave, arrive;  // Move: the contacts it leaves and reaches
+};
+
+// Designs the transitions between consecutive kept stances. Returns an empty
+// string, or why the sequence cannot be interpolated (naming the stances).
+std::string designTransitions(const Plan& plan, const std::vector<int>& kept, std::vector<TransitionDesign>& out);
+
+struct MotionPiece {
+  std::vector<Configuration> knots;  // travelled from rest to rest
+  std::vector<ContactSpec> contacts; // held throughout
+  int stance = -1;                   // the plan stance whose contacts these are
+};
+
+struct TransitionOptions {
+  int steps = 20;                    // n: knots per transition
+  double lift = 0.03;                // m: straight part along each surface normal
+  double touch_clearance = 5e-4;     // m: the body is off its surface beyond this (contract: 1 mm)
+  int repair_attempts = 4;
+  double repair_step = 0.05;         // m: via-point height added per attempt
+  int refine_depth = 3;              // halvings of a segment whose middle fails the check
+  PostureGeneratorOptions posture;
+};
+
+struct TransitionOutcome {
+  bool ok = false;
+  bool cancelled = false;
+  std::string reason;                // on failure
+  std::vector<MotionPiece> pieces;
+  long posture_calls = 0;
+  bool repaired = false;
+  int refinements = 0;               // knots inserted between the n steps
+};
+
+class TransitionSolver {
+ public:
+  TransitionSolver(const Scenario& sc, TransitionOptions options);
+  TransitionOutcome solve(const Plan& plan, const TransitionDesign& d, const std::atomic<bool>* cancel = nullptr);
+  const TransitionOptions& options() const { return opt_; }
+
+ private:
+  struct Attempt;
+  bool solveFixed(const Plan& plan, const TransitionDesign& d, Attempt& at);
+  bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, Attempt& at);
+
+  const Scenario& sc_;
+  TransitionOptions opt_;
+  PostureGenerator generator_;
+  ValidityChecker checker_;
+  Kinematics kin_;
+};
+
+}  // namespace acyclic

@@ -1,0 +1,110 @@
+// acyclic-interpolator: turns a contact plan into a whole-body trajectory.
+//   File mode (--in PLAN --out TRAJECTORY): writes acyclic.trajectory/1.
+//   Progress on stderr on a terminal, nothing when not (or with -q).
+//   Exit: 0 written, 1 not interpolated (reason printed: a transition that
+//   cannot be repaired, or cancelled by SIGINT/SIGTERM), 2 bad input (a file,
+//   a field, an option, or a plan whose witnesses or sequence are not valid).
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "interpolator/interpolator.h"
+#include "planner/common/format_error.h"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void onSignal(int) { g_stop = true; }
+
+// The plan's "scenario" field, resolved against the plan's folder, then the current directory.
+std::string scenarioOfPlan(const std::string& plan_path) {
+  std::ifstream in(plan_path);
+  if (!in) throw acyclic::FormatError(plan_path, "", "cannot read the file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw acyclic::FormatError(plan_path, "", std::string("not JSON: ") + e.what());
+  }
+  if (!j.is_object() || !j.contains("scenario") || !j["scenario"].is_string())
+    throw acyclic::FormatError(plan_path, "scenario", "expected the scenario file's path (a string)");
+  const std::filesystem::path s = j["scenario"].get<std::string>();
+  if (s.is_absolute()) return s.string();
+  const std::filesystem::path beside = std::filesystem::path(plan_path).parent_path() / s;
+  if (std::filesystem::exists(beside)) return beside.string();
+  if (std::filesystem::exists(s)) return s.string();
+  throw acyclic::FormatError(plan_path, "scenario", "'" + s.string() +
+                             "' found neither beside the plan nor in the current directory (give --scenario)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  acyclic::InterpolatorOptions o;
+  CLI::App app{
+      "Interpolates a contact plan (acyclic.plan/1) into a whole-body trajectory (acyclic.trajectory/1):\n"
+      "the moving body's path between stances (straight along the surface normals, a spline between,\n"
+      "raised automatically where it collides), a posture at each of n steps, useless stances filtered,\n"
+      "timed within the joint velocity limits and a speed cap, at rest wherever a contact is made or\n"
+      "broken, sampled every dt.\n"
+      "Exit status: 0 written, 1 not interpolated (reason printed, or cancelled), 2 bad input."};
+  std::string in, out, scenario_path;
+  bool no_filter = false, quiet = false;
+  app.add_option("--in", in, "plan file (acyclic.plan/1)")->required();
+  app.add_option("--out", out, "trajectory file to write (acyclic.trajectory/1)")->required();
+  app.add_option("--scenario", scenario_path,
+                 "scenario file (default: the plan's 'scenario' field, beside the plan, else in the current directory)");
+  app.add_option("-n,--steps", o.steps, "posture-generator steps per transition")->capture_default_str();
+  app.add_option("--dt", o.dt, "sample period, s (the controller's)")->capture_default_str();
+  app.add_option("--speed-cap", o.speed_cap, "largest speed of any link origin, m/s")->capture_default_str();
+  app.add_option("--velocity-share", o.velocity_share, "share of each joint's velocity limit used")->capture_default_str();
+  app.add_option("--lift", o.lift, "straight motion along the surface normal on leaving and reaching, m")
+      ->capture_default_str();
+  app.add_flag("--no-filter", no_filter, "keep every stance of the plan");
+  app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
+  CLI11_PARSE(app, argc, argv);
+  o.filter = !no_filter;
+
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  try {
+    if (scenario_path.empty()) scenario_path = scenarioOfPlan(in);
+    const acyclic::Scenario sc = acyclic::Scenario::load(scenario_path);
+    const acyclic::Plan plan = acyclic::readPlan(in, sc);
+    const bool tty = !quiet && isatty(STDERR_FILENO);
+    auto progress = [&](const acyclic::InterpolationProgress& p) {
+      if (!tty) return;
+      std::fprintf(stderr, "\r%7.1f s  %-11s transition %d of %d  posture calls %ld   ", p.seconds, p.stage.c_str(),
+                   p.transition, p.transitions, p.posture_calls);
+    };
+    acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, o, progress, &g_stop);
+    if (tty) std::fprintf(stderr, "\n");
+    if (!r.success()) {
+      std::printf("acyclic-interpolator: %s: %s: %s\n", in.c_str(), acyclic::toString(r.status), r.reason.c_str());
+      return r.status == acyclic::InterpolationResult::Status::InvalidInput ? 2 : 1;
+    }
+    r.trajectory.plan = in;
+    r.trajectory.scenario = scenario_path;
+    acyclic::writeTrajectory(r.trajectory, sc, out);
+    const auto& s = r.trajectory.stats;
+    std::printf(
+        "acyclic-interpolator: %s: %d stances (%d filtered), %d transitions, %d repaired, %ld posture calls, "
+        "%.2f s\n",
+        sc.name.c_str(), s.stances_in, r.filtered, s.transitions, s.repairs, s.posture_calls, s.seconds);
+    std::printf("acyclic-interpolator: %zu samples (%.2f s of motion at dt %.3f s), %zu phases written to %s\n",
+                r.trajectory.samples.size(), r.trajectory.duration(), r.trajectory.dt, r.trajectory.phases.size(),
+                out.c_str());
+    return 0;
+  } catch (const acyclic::FormatError& e) {
+    std::fprintf(stderr, "acyclic-interpolator: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "acyclic-interpolator: error: %s\n", e.what());
+    return 2;
+  }
+}
