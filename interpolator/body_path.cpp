@@ -6,7 +6,7 @@
 namespace acyclic {
 
 namespace {
-constexpr int kTableSteps = 64;  // arc-length table entries per spline segment
+constexpr int kTableSteps = 256;  // arc-length table entries per spline segment
 }
 
 BodyPath::BodyPath(BodyPathEnd from, BodyPathEnd to, double lift, std::vector<Eigen::Vector3d> vias)
@@ -22,12 +22,14 @@ BodyPath::BodyPath(BodyPathEnd from, BodyPathEnd to, double lift, std::vector<Ei
   tangents_.resize(m);
   for (int i = 0; i < m; ++i) {
     if (i == 0) {
-      const double chord = (points_[1] - points_[0]).norm();
+      // Tangents along the normals no longer than twice the lift: a long
+      // motion does not bulge far above its straight parts.
+      const double chord = std::min((points_[1] - points_[0]).norm(), 2 * lift);
       // Leaving along the normal: the spline starts in the direction of the
       // straight part (C1 at the junction, same speed per unit of u).
       tangents_[i] = from_.normal ? Eigen::Vector3d(chord * *from_.normal) : Eigen::Vector3d(points_[1] - points_[0]);
     } else if (i == m - 1) {
-      const double chord = (points_[m - 1] - points_[m - 2]).norm();
+      const double chord = std::min((points_[m - 1] - points_[m - 2]).norm(), 2 * lift);
       tangents_[i] = to_.normal ? Eigen::Vector3d(-chord * *to_.normal) : Eigen::Vector3d(points_[m - 1] - points_[m - 2]);
     } else {
       tangents_[i] = 0.5 * (points_[i + 1] - points_[i - 1]);  // Catmull-Rom
@@ -87,6 +89,11 @@ Eigen::Isometry3d BodyPath::pose(double s) const {
   return T;
 }
 
+bool BodyPath::straightAt(double s) const {
+  const double d = std::clamp(s, 0.0, 1.0) * length();
+  return (lift0_ > 0 && d <= lift0_ + 1e-12) || (lift1_ > 0 && d >= length() - lift1_ - 1e-12);
+}
+
 double BodyPath::leaveParameter(double clearance) const {
   return from_.normal && length() > 0 ? std::min(clearance, lift0_) / length() : 0.0;
 }
@@ -101,8 +108,17 @@ BodyPath BodyPath::raised(double height) const {
   if (to_.normal) up += *to_.normal;
   if (up.norm() < 1e-6) up = Eigen::Vector3d::UnitZ();
   up.normalize();
-  const Eigen::Vector3d mid = 0.5 * (points_.front() + points_.back());
-  return BodyPath(from_, to_, lift_, {mid + height * up});
+  // A bridge: rise to `height` above the higher end of the spline by a third
+  // of the way, cross at that height, come down over the last third. It
+  // clears an obstacle between the ends, or an edge the lower end is below.
+  const Eigen::Vector3d a = points_.front(), b = points_.back();
+  const double top = std::max(a.dot(up), b.dot(up)) + height;
+  std::vector<Eigen::Vector3d> vias;
+  for (double f : {1.0 / 3, 2.0 / 3}) {
+    const Eigen::Vector3d v = a + f * (b - a);
+    vias.push_back(v + (top - v.dot(up)) * up);
+  }
+  return BodyPath(from_, to_, lift_, vias);
 }
 
 }  // namespace acyclic

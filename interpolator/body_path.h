@@ -26,11 +26,14 @@ class BodyPath {
   // The parameter at which the body is `clearance` off its start (end) surface
   // along the normal; 0 (1) when that end is not on a surface.
   double leaveParameter(double clearance) const;
+  // Whether s lies on a straight part (near a surface: orientation held).
+  bool straightAt(double s) const;
   double arriveParameter(double clearance) const;
 
-  // The same ends with one via-point `height` above the middle of the spline
-  // (along the mean of the end normals, or world z): a repair that raises the
-  // path away from what it collides with.
+  // The same ends with two via-points, at a third and two thirds of the way,
+  // `height` above the higher end of the spline (along the mean of the end
+  // normals, or world z): a repair that raises the path away from what it
+  // collides with.
   BodyPath raised(double height) const;
   const std::vector<Eigen::Vector3d>& vias() const { return vias_; }
 

@@ -38,6 +38,8 @@ std::string validateOptions(const InterpolatorOptions& o) {
   if (!(o.velocity_share > 0 && o.velocity_share <= 1)) return "the velocity share must be in (0, 1]";
   if (!(o.lift > o.touch_clearance && o.touch_clearance > 0 && o.touch_clearance < 1e-3))
     return "expected 0 < touch clearance < 1 mm and lift > touch clearance";
+  if (!(o.air_orientation_tolerance >= 0 && o.air_orientation_tolerance < 1))
+    return "the orientation tolerance in the air must be in [0, 1)";
   if (o.repair_attempts < 0 || !(o.repair_step > 0) || o.refine_depth < 0 || o.posture_iterations < 1)
     return "repair attempts, refinement depth and posture iterations must be non-negative, the repair step positive";
   return "";
@@ -79,6 +81,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.steps = opt.steps;
   to.lift = opt.lift;
   to.touch_clearance = opt.touch_clearance;
+  to.air_orientation_tolerance = opt.air_orientation_tolerance;
   to.repair_attempts = opt.repair_attempts;
   to.repair_step = opt.repair_step;
   to.refine_depth = opt.refine_depth;

@@ -16,14 +16,15 @@ Configuration lerp(const Configuration& a, const Configuration& b, double f) {
 TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel& robot, Kinematics& kin,
                        const TimeLawOptions& opt)
     : knots_(knots), dt_(opt.dt) {
-  // Link origins at each knot, for the speed cap.
-  std::vector<std::vector<Eigen::Vector3d>> origins;
-  for (const auto& q : knots_) {
+  // Link origins along each segment, for the speed cap: joints move linearly,
+  // so links move on arcs; a few sub-chords measure them.
+  constexpr int kSub = 4;
+  auto origins = [&](const Configuration& q) {
     kin.setConfiguration(q);
     std::vector<Eigen::Vector3d> o;
     for (int l = 0; l < robot.numLinks(); ++l) o.push_back(kin.linkPose(l).translation());
-    origins.push_back(std::move(o));
-  }
+    return o;
+  };
   cum_.push_back(0);
   for (std::size_t k = 0; k + 1 < knots_.size(); ++k) {
     // The time this segment takes at unit rate, every joint and link at or under its limit.
@@ -31,8 +32,14 @@ TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel
     for (const auto& j : robot.joints())
       len = std::max(len, std::abs(knots_[k + 1].joints[j.index] - knots_[k].joints[j.index]) /
                               (opt.velocity_share * j.velocity));
-    for (int l = 0; l < robot.numLinks(); ++l)
-      len = std::max(len, (origins[k + 1][l] - origins[k][l]).norm() / opt.speed_cap);
+    std::vector<double> arc(robot.numLinks(), 0.0);
+    std::vector<Eigen::Vector3d> prev = origins(knots_[k]);
+    for (int i = 1; i <= kSub; ++i) {
+      const std::vector<Eigen::Vector3d> cur = origins(lerp(knots_[k], knots_[k + 1], static_cast<double>(i) / kSub));
+      for (int l = 0; l < robot.numLinks(); ++l) arc[l] += (cur[l] - prev[l]).norm();
+      prev = cur;
+    }
+    for (int l = 0; l < robot.numLinks(); ++l) len = std::max(len, arc[l] / opt.speed_cap);
     seg_.push_back(len);
     cum_.push_back(cum_.back() + len);
   }

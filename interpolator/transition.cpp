@@ -177,20 +177,22 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     if (d.leave) e0.normal = sc_.scene->surfaces()[d.leave->surface].frame.linear().col(2);
     if (d.arrive) e1.normal = sc_.scene->surfaces()[d.arrive->surface].frame.linear().col(2);
     const BodyPath path(e0, e1, opt_.lift);
-    std::string first_reason;
+    std::string reasons;
     for (int attempt = 0; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt) {
       at.pieces.clear();
-      const BodyPath p = attempt == 0 ? path : path.raised(attempt * opt_.repair_step);
+      const double h = attempt * opt_.repair_step;
+      const BodyPath p = attempt == 0 ? path : path.raised(h);
       if (solveMove(plan, d, p, at)) {
         out.ok = true;
         out.repaired = attempt > 0;
         break;
       }
-      if (attempt == 0) first_reason = at.reason;
+      char buf[64];
+      std::snprintf(buf, sizeof buf, attempt == 0 ? "as planned: " : "via-point %.2f m up: ", h);
+      reasons += (reasons.empty() ? "" : "; ") + std::string(buf) + at.reason;
     }
     if (!out.ok && !at.cancelled)
-      at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired after " +
-                  std::to_string(opt_.repair_attempts) + " raised via-points: " + first_reason + "; last: " + at.reason;
+      at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
   }
   out.cancelled = at.cancelled;
   out.reason = at.cancelled ? "cancelled" : at.reason;
@@ -267,6 +269,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     t.spot = d.spot;
     t.pose = path.pose(s);
     t.touch_obstacles = touch;
+    t.orientation_tolerance = path.straightAt(s) ? 0.0 : opt_.air_orientation_tolerance;
     r.pose_target = t;
     r.initial_guess = guess;
     const Configuration ref = lerp(q0, q1, s);

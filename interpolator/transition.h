@@ -57,6 +57,10 @@ struct TransitionOptions {
   int steps = 20;                    // n: knots per transition
   double lift = 0.03;                // m: straight part along each surface normal
   double touch_clearance = 5e-4;     // m: the body is off its surface beyond this (contract: 1 mm)
+  // On the spline (in the air) the body's orientation follows the slerp only
+  // within this bound on each orientation row (PoseTarget); on the straight
+  // parts, near a surface, exactly.
+  double air_orientation_tolerance = 0.3;
   int repair_attempts = 4;
   double repair_step = 0.05;         // m: via-point height added per attempt
   int refine_depth = 3;              // halvings of a segment whose middle fails the check

@@ -225,6 +225,37 @@ TEST(PostureGenerator, PoseTargetIsReached) {
   EXPECT_NE(b.reason.find("r_sole"), std::string::npos) << b.reason;
 }
 
+TEST(PostureGenerator, PoseTargetOrientationTolerance) {
+  // Seated, the hanging left arm cannot raise its wrist 2 cm keeping the
+  // wrist's orientation exactly; within a tolerance on the orientation rows it can.
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  PoseTarget t;
+  t.spot = sc.robot->spotIndex("l_wrist");
+  t.pose = k.spotPose(t.spot);
+  t.pose.translation().z() += 0.02;
+  r.pose_target = t;
+  EXPECT_FALSE(pg.solve(r).success());
+  r.pose_target->orientation_tolerance = 0.3;
+  const PostureResult res = pg.solve(r);
+  ASSERT_TRUE(res.success()) << res.reason;
+  expectValid(sc, res, sc.start_stance);
+  k.setConfiguration(res.configuration);
+  const Eigen::Isometry3d at = k.spotPose(t.spot);
+  EXPECT_LT((at.translation() - t.pose.translation()).norm(), 1e-5);
+  const Eigen::Matrix3d S = at.linear(), T = t.pose.linear();
+  for (double row : {S.col(2).dot(T.col(0)), S.col(2).dot(T.col(1)), S.col(0).dot(T.col(1))})
+    EXPECT_LE(std::abs(row), 0.3 + 1e-6);
+  // The bound is checked: outside [0, 1) the request is refused.
+  r.pose_target->orientation_tolerance = 1.5;
+  EXPECT_EQ(pg.solve(r).status, PostureResult::Status::BadInput);
+}
+
 TEST(PostureProblem, StaticsRowsAreSimbodysGravityTorques) {
   // With no contact force the joint rows are Simbody's g(q) / weight.
   const Scenario& sc = chair();

@@ -83,6 +83,8 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
     if (!spots.insert(t.spot).second)
       throw std::invalid_argument("spot " + robot_->spots()[t.spot].name + " is in a contact and a pose target");
     if (!t.pose.matrix().allFinite()) throw std::invalid_argument("pose target has a non-finite value");
+    if (!(t.orientation_tolerance >= 0 && t.orientation_tolerance < 1))
+      throw std::invalid_argument("pose target: orientation tolerance outside [0, 1)");
     for (int o : t.touch_obstacles) {
       if (o < 0 || o >= static_cast<int>(scene_->obstacles().size())) throw std::invalid_argument("unknown obstacle");
       allowed_touch_.push_back({robot_->spots()[t.spot].link, o});
@@ -232,6 +234,10 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
     halfPlanes(scene_->surfaces()[f.surface].polygon, n, b);
     for (std::size_t k = 0; k < robot_->spots()[f.spot].polygon.size(); ++k)
       for (double bi : b) gl[r] = -kInf, gu[r++] = bi - kFloatingPolygonMargin;
+  }
+  if (req_.pose_target) {
+    const int r = 6 * (numContacts() - 1);  // the pose target's rows come last among the contacts'
+    for (int k = 3; k < 6; ++k) gl[r + k] = -req_.pose_target->orientation_tolerance, gu[r + k] = req_.pose_target->orientation_tolerance;
   }
   for (const auto& j : robot_->joints()) {
     const double W = robot_->totalMass() * 9.81;  // statics rows are in units of the weight

@@ -54,6 +54,10 @@ struct PoseTarget {
   // Obstacles the spot's link may touch (the surfaces it leaves or reaches:
   // near them its pose, not a collision margin, keeps it clear).
   std::vector<int> touch_obstacles;
+  // Bound on each orientation row (about the sine of the tilt about each
+  // axis): 0 holds the orientation exactly; a body in the air needs only its
+  // position on the path, its orientation roughly.
+  double orientation_tolerance = 0;
 };
 
 struct PostureRequest {

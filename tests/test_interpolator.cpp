@@ -1,0 +1,419 @@
+// The trajectory interpolator (issue 5): the moving body's path, the time law,
+// and whole interpolations of small plans built here with the posture
+// generator (a foot step on the floor, a hand reaching the table and leaving
+// it, a step over a box that forces a repair), each output checked sample by
+// sample by the independent trajectory check.
+#include <gtest/gtest.h>
+
+#include <atomic>
+
+#include "interpolator/body_path.h"
+#include "interpolator/interpolator.h"
+#include "interpolator/time_law.h"
+#include "planner/check/trajectory_check.h"
+#include "test_support.h"
+
+using namespace acyclic;
+
+namespace {
+
+const Scenario& floorScenario() {
+  static Scenario sc = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml"));
+  return sc;
+}
+const Scenario& boxScenario() {
+  static Scenario sc = Scenario::load(test::sourcePath("tests/data/step_over_box.yaml"));
+  return sc;
+}
+const Scenario& chairScenario() {
+  static Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));
+  return sc;
+}
+
+PlanStance stance(const std::vector<ContactSpec>& contacts, const Configuration& q) {
+  PlanStance s;
+  for (const auto& c : contacts) {
+    PlanContact pc;
+    pc.spec = c;
+    s.contacts.push_back(pc);
+  }
+  s.configuration = q;
+  return s;
+}
+
+Configuration witness(const Scenario& sc, const std::vector<ContactSpec>& contacts, const Configuration& guess) {
+  PostureGenerator pg(sc.robot, sc.scene);
+  PostureRequest r;
+  r.contacts = contacts;
+  r.initial_guess = guess;
+  const PostureResult res = pg.solve(r);
+  EXPECT_TRUE(res.success()) << res.reason;
+  return res.configuration;
+}
+
+// A plan of one right-foot step of `length` metres, as the contact planner
+// writes one: both feet; the right foot unloaded; the left foot alone (settled);
+// the right foot touching ahead; both feet supporting.
+Plan stepPlan(const Scenario& sc, double length) {
+  const Configuration q0 = sc.start;
+  const int ri = sc.start_stance[0].spot == sc.robot->spotIndex("r_sole") ? 0 : 1;
+  const ContactSpec r0 = sc.start_stance[ri], l = sc.start_stance[1 - ri];
+  ContactSpec r0_free = r0, r1 = r0, r1_free = r0;
+  r1.placement.x += length;
+  r1_free.placement.x += length;
+  r0_free.supporting = r1_free.supporting = false;
+  const Configuration q1 = witness(sc, {r0_free, l}, q0);
+  Configuration guess = q1;
+  guess.base_position.x() += 0.5 * length;
+  const Configuration q3 = witness(sc, {l, r1_free}, guess);
+  const Configuration q2 = witness(sc, {l}, q3);
+  Plan p;
+  p.scenario = sc.path;
+  p.stances = {stance({r0, l}, q0), stance({r0_free, l}, q1), stance({l}, q2), stance({l, r1_free}, q3),
+               stance({l, r1}, q3)};
+  return p;
+}
+
+// The chair's start stance; the left wrist touching the table; back to the start stance.
+Plan handPlan() {
+  const Scenario& sc = chairScenario();
+  PostureGenerator pg(sc.robot, sc.scene);
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  FloatingContact f;
+  f.spot = sc.robot->spotIndex("l_palm");
+  f.surface = sc.scene->surfaceIndex("table_top");
+  f.volume.polygon = sc.scene->surfaces()[f.surface].polygon;
+  r.floating = f;
+  const PostureResult res = pg.solve(r);
+  EXPECT_TRUE(res.success()) << res.reason;
+  std::vector<ContactSpec> touching = sc.start_stance;
+  ContactSpec w;
+  w.spot = f.spot;
+  w.surface = f.surface;
+  w.supporting = false;
+  w.placement = res.floating;
+  touching.push_back(w);
+  Plan p;
+  p.scenario = sc.path;
+  p.stances = {stance(sc.start_stance, sc.start), stance(touching, res.configuration), stance(sc.start_stance, sc.start)};
+  return p;
+}
+
+void expectValid(const Trajectory& tr, const Scenario& sc) {
+  ValidityChecker checker(sc.robot, sc.scene);
+  const TrajectoryReport rep = checkTrajectory(tr, sc, checker);
+  for (const auto& p : rep.parts)
+    EXPECT_TRUE(p.ok()) << p.name << ": " << p.summary << (p.violations.empty() ? "" : " | " + p.violations[0]);
+  EXPECT_EQ(rep.invalid_samples, 0);
+}
+
+Eigen::Isometry3d spotAt(const Scenario& sc, const Configuration& q, int spot) {
+  Kinematics k(sc.robot);
+  k.setConfiguration(q);
+  return k.spotPose(spot);
+}
+
+}  // namespace
+
+// --- The moving body's path ---------------------------------------------------
+
+TEST(BodyPath, LeavesAndArrivesAlongTheNormalsAndIsC1) {
+  BodyPathEnd a, b;
+  a.pose.translation() = Eigen::Vector3d(0, 0, 0);
+  a.normal = Eigen::Vector3d::UnitZ();
+  b.pose.translation() = Eigen::Vector3d(0.3, 0.1, 0.2);
+  b.pose.linear() = Eigen::AngleAxisd(0.8, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  b.normal = Eigen::Vector3d(0, 0, 1);
+  const BodyPath p(a, b, 0.03);
+  EXPECT_LT((p.pose(0).translation() - a.pose.translation()).norm(), 1e-12);
+  EXPECT_LT((p.pose(1).translation() - b.pose.translation()).norm(), 1e-12);
+  EXPECT_LT(Eigen::AngleAxisd(p.pose(1).linear().transpose() * b.pose.linear()).angle(), 1e-9);
+  // Straight up, orientation held, over the first 3 cm of arc length; straight down over the last.
+  const double L = p.length();
+  for (double d : {0.0, 0.01, 0.029}) {
+    const Eigen::Isometry3d T = p.pose(d / L);
+    EXPECT_NEAR(T.translation().z(), d, 1e-9);
+    EXPECT_NEAR(T.translation().head<2>().norm(), 0, 1e-9);
+    EXPECT_LT(Eigen::AngleAxisd(T.linear()).angle(), 1e-12);
+    const Eigen::Isometry3d E = p.pose(1 - d / L);
+    EXPECT_NEAR((E.translation() - b.pose.translation() - Eigen::Vector3d(0, 0, d)).norm(), 0, 1e-9);
+  }
+  EXPECT_NEAR(p.leaveParameter(5e-4) * L, 5e-4, 1e-12);
+  EXPECT_NEAR((1 - p.arriveParameter(5e-4)) * L, 5e-4, 1e-12);
+  // Arc length: equal steps of s move the body equal distances (within the table's resolution).
+  const int n = 400;
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d d = p.pose((i + 1.0) / n).translation() - p.pose(static_cast<double>(i) / n).translation();
+    EXPECT_NEAR(d.norm(), L / n, 0.03 * L / n) << i;
+    sum += d.norm();
+  }
+  EXPECT_NEAR(sum, L, 1e-3 * L);
+  // C1: no corner where the straight parts meet the spline (a corner would turn by about 90 degrees).
+  for (double j : {0.03, L - 0.03}) {
+    const double e = 1e-5;
+    const Eigen::Vector3d before = p.pose(j / L).translation() - p.pose((j - e) / L).translation();
+    const Eigen::Vector3d after = p.pose((j + e) / L).translation() - p.pose(j / L).translation();
+    EXPECT_GT(before.normalized().dot(after.normalized()), std::cos(0.02)) << "junction at " << j;
+  }
+}
+
+TEST(BodyPath, RaisedPathPassesHigher) {
+  BodyPathEnd a, b;
+  a.normal = b.normal = Eigen::Vector3d::UnitZ();
+  b.pose.translation() = Eigen::Vector3d(0.25, 0, 0);
+  b.pose.translation().z() = 0.1;  // the far end higher
+  const BodyPath p(a, b, 0.03), r = p.raised(0.1);
+  // The bridge crosses 0.1 m above the higher end's straight part.
+  EXPECT_NEAR(r.pose(0.5).translation().z(), 0.23, 0.01);
+  EXPECT_LT(p.pose(0.5).translation().z(), 0.13);
+  EXPECT_LT((r.pose(1).translation() - b.pose.translation()).norm(), 1e-12);
+}
+
+// --- The time law -----------------------------------------------------------
+
+namespace {
+// Runs a piece at dt and returns the worst joint speed ratio (stored and
+// finite-difference) and the worst link-origin speed; checks rest at both ends.
+std::pair<double, double> runPiece(const Scenario& sc, const std::vector<Configuration>& knots, const TimeLawOptions& opt) {
+  Kinematics kin(sc.robot);
+  const TimedPiece piece(knots, *sc.robot, kin, opt);
+  EXPECT_GT(piece.steps(), 0);
+  EXPECT_NEAR(piece.duration(), piece.steps() * opt.dt, 1e-12);
+  Eigen::VectorXd dq;
+  piece.at(0, &dq);
+  EXPECT_EQ(dq.norm(), 0.0);
+  const Configuration end = piece.at(piece.duration(), &dq);
+  EXPECT_EQ(dq.norm(), 0.0);
+  EXPECT_LT((end.joints - knots.back().joints).norm() + (end.base_position - knots.back().base_position).norm(), 1e-12);
+  double worst_ratio = 0, worst_speed = 0;
+  Configuration prev = piece.at(0);
+  std::vector<Eigen::Vector3d> prev_origins;
+  kin.setConfiguration(prev);
+  for (int l = 0; l < sc.robot->numLinks(); ++l) prev_origins.push_back(kin.linkPose(l).translation());
+  for (int i = 1; i <= piece.steps(); ++i) {
+    const Configuration q = piece.at(i * opt.dt, &dq);
+    for (const auto& j : sc.robot->joints()) {
+      worst_ratio = std::max(worst_ratio, std::abs(dq[j.index]) / j.velocity);
+      worst_ratio = std::max(worst_ratio, std::abs(q.joints[j.index] - prev.joints[j.index]) / opt.dt / j.velocity);
+    }
+    kin.setConfiguration(q);
+    for (int l = 0; l < sc.robot->numLinks(); ++l) {
+      worst_speed = std::max(worst_speed, (kin.linkPose(l).translation() - prev_origins[l]).norm() / opt.dt);
+      prev_origins[l] = kin.linkPose(l).translation();
+    }
+    prev = q;
+  }
+  return {worst_ratio, worst_speed};
+}
+}  // namespace
+
+TEST(TimeLaw, RestToRestWithinTheJointVelocityLimits) {
+  const Scenario& sc = floorScenario();
+  Configuration a = sc.start, b = sc.start, c = sc.start;
+  b.joints[sc.robot->jointIndex("RARM_JOINT0")] -= 1.2;  // a joint's long move, then another's
+  c.joints = b.joints;
+  c.joints[sc.robot->jointIndex("LLEG_JOINT3")] += 0.5;
+  TimeLawOptions opt;
+  opt.speed_cap = 100;  // out of the way
+  const auto [ratio, speed] = runPiece(sc, {a, b, c}, opt);
+  EXPECT_LE(ratio, opt.velocity_share + 1e-9);
+  EXPECT_GT(ratio, 0.8 * opt.velocity_share);  // and not needlessly slow: the profile's peak reaches the limit
+}
+
+TEST(TimeLaw, LinkSpeedsWithinTheCap) {
+  const Scenario& sc = floorScenario();
+  Configuration a = sc.start, b = sc.start, c = sc.start;
+  b.base_position.x() += 0.1;
+  c = b;
+  c.joints[sc.robot->jointIndex("RARM_JOINT0")] -= 1.0;  // the hand on an arc
+  TimeLawOptions opt;
+  opt.speed_cap = 0.05;
+  const auto [ratio, speed] = runPiece(sc, {a, b, c}, opt);
+  EXPECT_LE(ratio, opt.velocity_share + 1e-9);
+  // Links move on arcs between knots (joint space is linear), measured by sub-chords.
+  EXPECT_LE(speed, opt.speed_cap * 1.01);
+  EXPECT_GT(speed, 0.8 * opt.speed_cap);
+}
+
+TEST(TimeLaw, MotionlessPieceTakesNoTime) {
+  const Scenario& sc = floorScenario();
+  Kinematics kin(sc.robot);
+  const TimedPiece piece({sc.start, sc.start}, *sc.robot, kin, {});
+  EXPECT_EQ(piece.steps(), 0);
+}
+
+// --- Whole interpolations ---------------------------------------------------------
+
+TEST(Interpolator, SingleFootStepOnTheFloor) {
+  const Scenario& sc = floorScenario();
+  const Plan plan = stepPlan(sc, 0.15);
+  InterpolatorOptions opt;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  const Trajectory& tr = r.trajectory;
+  EXPECT_EQ(tr.stats.stances_in, 5);
+  EXPECT_EQ(r.filtered, 0);
+  EXPECT_EQ(tr.stats.transitions, 3);  // unload (fixed contacts), step (moving foot), load (no motion)
+  EXPECT_EQ(tr.stats.repairs, 0);
+  EXPECT_GT(tr.stats.posture_calls, 2 * opt.steps - 2);
+  expectValid(tr, sc);
+  // Phases: both feet; right foot unloaded; left foot alone (stance 2); right foot touching ahead.
+  ASSERT_EQ(tr.phases.size(), 4u);
+  EXPECT_EQ(tr.phases[2].stance, 2);
+  EXPECT_EQ(tr.phases[2].contacts.size(), 1u);
+  // The foot rises straight, clears the floor by about the lift height, and lands on its new foothold.
+  const int r_sole = sc.robot->spotIndex("r_sole");
+  const double x0 = spotAt(sc, tr.samples.front().q, r_sole).translation().x();
+  double top = 0;
+  for (const auto& s : tr.samples) {
+    if (s.phase != 2) continue;
+    const Eigen::Isometry3d T = spotAt(sc, s.q, r_sole);
+    top = std::max(top, T.translation().z());
+    if (T.translation().z() < 0.02) {  // on a straight part: above one of the two footholds
+      const double dx = std::min(std::abs(T.translation().x() - x0), std::abs(T.translation().x() - x0 - 0.15));
+      EXPECT_LT(dx, 2e-3) << "t = " << s.t;
+    }
+  }
+  EXPECT_GT(top, opt.lift);
+  EXPECT_LT(top, opt.lift + 0.03);
+  const Eigen::Isometry3d end = spotAt(sc, tr.samples.back().q, r_sole);
+  EXPECT_NEAR(end.translation().x(), x0 + 0.15, 1e-3);
+  EXPECT_NEAR(end.translation().z(), 0.0, 1e-3);
+  // Rest at the start, the end and every phase change.
+  EXPECT_EQ(tr.samples.front().dq.norm(), 0.0);
+  EXPECT_EQ(tr.samples.back().dq.norm(), 0.0);
+}
+
+TEST(Interpolator, SameInputSameOutput) {
+  const Scenario& sc = floorScenario();
+  const Plan plan = stepPlan(sc, 0.15);
+  InterpolatorOptions opt;
+  opt.steps = 8;
+  const InterpolationResult a = interpolate(plan, sc, opt), b = interpolate(plan, sc, opt);
+  ASSERT_TRUE(a.success() && b.success());
+  ASSERT_EQ(a.trajectory.samples.size(), b.trajectory.samples.size());
+  for (std::size_t i = 0; i < a.trajectory.samples.size(); ++i)
+    ASSERT_EQ(a.trajectory.samples[i].q.joints, b.trajectory.samples[i].q.joints) << i;
+}
+
+TEST(Interpolator, HandReachesTheTableAndLeavesIt) {
+  const Scenario& sc = chairScenario();
+  const Plan plan = handPlan();
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  const Trajectory& tr = r.trajectory;
+  EXPECT_EQ(tr.stats.transitions, 2);
+  expectValid(tr, sc);
+  // The palm touches the table in the middle phase; over the table top and
+  // within 2 cm of it, it is straight above its placement.
+  const ContactSpec& w = plan.stances[1].contacts.back().spec;
+  const Surface& table = sc.scene->surfaces()[w.surface];
+  int touching_phase = -1;
+  for (std::size_t k = 0; k < tr.phases.size(); ++k)
+    if (tr.phases[k].contacts.size() == 5) touching_phase = static_cast<int>(k);
+  ASSERT_GE(touching_phase, 0);
+  EXPECT_EQ(tr.phases[touching_phase].stance, 1);
+  bool touched = false;
+  int near_samples = 0;
+  for (const auto& s : tr.samples) {
+    const Eigen::Vector3d p = table.frame.inverse() * spotAt(sc, s.q, w.spot).translation();  // z: height over the top
+    const Eigen::Vector2d off = p.head<2>() - Eigen::Vector2d(w.placement.x, w.placement.y);
+    if (table.polygon.contains(p.head<2>(), 0) && p.z() < 0.02) {
+      ++near_samples;
+      EXPECT_LT(off.norm(), 2e-3) << "t = " << s.t;
+      EXPECT_GT(p.z(), -1e-3) << "t = " << s.t;
+    }
+    touched = touched || (s.phase == touching_phase && off.norm() < 1e-3 && std::abs(p.z()) < 1e-3);
+  }
+  EXPECT_GT(near_samples, 10);
+  EXPECT_TRUE(touched);
+}
+
+TEST(Interpolator, FilteringDropsTheUselessTouchAndKeepsValidity) {
+  const Scenario& sc = chairScenario();
+  const Plan plan = handPlan();
+  const InterpolationResult r = interpolate(plan, sc, {});
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.filtered, 1);
+  EXPECT_EQ(r.trajectory.stats.stances_kept, 2);
+  for (const auto& ph : r.trajectory.phases) EXPECT_EQ(ph.contacts.size(), 4u);  // the wrist never touches
+  expectValid(r.trajectory, sc);
+}
+
+TEST(Interpolator, CollidingStepIsRepairedByRaisingThePath) {
+  const Scenario& sc = boxScenario();
+  const Plan plan = stepPlan(sc, 0.28);
+  InterpolatorOptions opt;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+  // Without repairs the same plan is reported with the stances of the failing transition.
+  opt.repair_attempts = 0;
+  const InterpolationResult u = interpolate(plan, sc, opt);
+  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
+  EXPECT_EQ(u.failed_stances, (std::vector<int>{1, 3}));
+  EXPECT_NE(u.reason.find("stances 1 -> 3"), std::string::npos) << u.reason;
+  EXPECT_TRUE(u.trajectory.samples.empty());
+}
+
+TEST(Interpolator, BadInputAndCancellation) {
+  const Scenario& sc = floorScenario();
+  Plan plan = stepPlan(sc, 0.15);
+  InterpolatorOptions opt;
+  opt.dt = 0;
+  EXPECT_EQ(interpolate(plan, sc, opt).status, InterpolationResult::Status::InvalidInput);
+  // A witness that breaks the contract: the foot below the floor.
+  Plan sunk = plan;
+  sunk.stances[2].configuration.base_position.z() -= 0.05;
+  const InterpolationResult s = interpolate(sunk, sc, {});
+  EXPECT_EQ(s.status, InterpolationResult::Status::InvalidInput);
+  EXPECT_NE(s.reason.find("stance 2"), std::string::npos) << s.reason;
+  // Two contacts changed in one step.
+  Plan jump = plan;
+  jump.stances.erase(jump.stances.begin() + 1, jump.stances.begin() + 3);
+  const InterpolationResult j = interpolate(jump, sc, {});
+  EXPECT_EQ(j.status, InterpolationResult::Status::InvalidInput);
+  EXPECT_NE(j.reason.find("stances 0 -> 1"), std::string::npos) << j.reason;
+  std::atomic<bool> cancel{true};
+  EXPECT_EQ(interpolate(plan, sc, {}, {}, &cancel).status, InterpolationResult::Status::Cancelled);
+}
+
+// --- The trajectory check finds what breaks the contract ------------------------------
+
+TEST(TrajectoryCheck, FindsEachKindOfViolation) {
+  const Scenario& sc = floorScenario();
+  const InterpolationResult r = interpolate(stepPlan(sc, 0.15), sc, {});
+  ASSERT_TRUE(r.success()) << r.reason;
+  ValidityChecker checker(sc.robot, sc.scene);
+  auto failing = [&](const Trajectory& tr) {
+    std::vector<std::string> names;
+    for (const auto& p : checkTrajectory(tr, sc, checker).parts)
+      if (!p.ok()) names.push_back(p.name);
+    return names;
+  };
+  const Trajectory& good = r.trajectory;
+  // A contact drifting by 2 mm: the base moved under a held foot.
+  Trajectory drift = good;
+  const int mid = static_cast<int>(drift.samples.size()) / 2;
+  drift.samples[mid].q.base_position.y() += 0.002;
+  EXPECT_EQ(failing(drift), (std::vector<std::string>{"samples"}));
+  // A stored velocity over a limit.
+  Trajectory fast = good;
+  fast.samples[mid].dq[0] = 1.5 * sc.robot->joints()[0].velocity;
+  EXPECT_EQ(failing(fast), (std::vector<std::string>{"velocity limits"}));
+  // Moving where the foot leaves the floor.
+  Trajectory moving = good;
+  const int leave = static_cast<int>(std::lround(moving.phases[2].t_start / moving.dt));
+  moving.samples[leave].dq[3] = 0.01;
+  EXPECT_EQ(failing(moving), (std::vector<std::string>{"rest at contact changes"}));
+  // A sample claiming a phase it is not in.
+  Trajectory phases = good;
+  phases.samples[1].phase = 3;
+  EXPECT_FALSE(checkTrajectory(phases, sc, checker).valid());
+}
