@@ -1,54 +1,64 @@
-// acyclic-planner: plans a scenario's contacts (file mode) and writes an
-// acyclic.plan/1 file. Progress goes to stderr on a terminal, nothing when not.
-// Exit status: 0 solved, 1 not solved (the reason is printed), 2 bad input.
+// acyclic-planner: plans a scenario's contacts.
+//   File mode (--in SCENARIO --out PLAN): writes acyclic.plan/1. Progress on
+//   stderr on a terminal, nothing when not. Exit: 0 solved, 1 not solved
+//   (reason printed), 2 bad input.
+//   LCM mode (--lcm): serves ACYCLIC_REQUEST, answers ACYCLIC_PLAN, reports on
+//   ACYCLIC_PROGRESS and ACYCLIC_STATUS, obeys ACYCLIC_CANCEL (planner_service).
 #include <CLI/CLI.hpp>
 
-#include <csignal>
 #include <cstdio>
 #include <unistd.h>
 
 #include "planner/common/format_error.h"
 #include "planner/search/planner_parameters.h"
-
-namespace {
-std::atomic<bool> g_cancel{false};
-void onSignal(int) { g_cancel = true; }
-}  // namespace
+#include "processes/lcm_process.h"
+#include "processes/planner_service.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Plans the contacts of a scenario (Escande et al., ISER 2008): best-first search over sets of\n"
-               "contacts driven by the guide potential of the scenario's key postures. Writes acyclic.plan/1.\n"
-               "Exit status: 0 solved, 1 not solved (reason printed), 2 bad input."};
-  std::string in, out;
-  long seed = -1;
-  double max_seconds = -1;
-  long max_nodes = -1, max_calls = -1;
-  bool eager = false, random_candidates = false, goal_distance = false, quiet = false;
-  app.add_option("--in", in, "scenario file (acyclic.scenario/1)")->required();
-  app.add_option("--out", out, "plan file to write (acyclic.plan/1)")->required();
-  app.add_option("--seed", seed, "overrides the scenario's seed");
-  app.add_option("--max-seconds", max_seconds, "wall-time budget (default: the scenario's planner section, else 60)");
-  app.add_option("--max-nodes", max_nodes, "nodes generated at most (default: scenario, else 1000)");
-  app.add_option("--max-posture-calls", max_calls, "posture-generator calls at most (default: scenario, else 20000)");
-  app.add_flag("--eager-sons", eager, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
-  app.add_flag("--random-candidates", random_candidates,
+  CLI::App app{
+      "Plans the contacts of a scenario (Escande et al., ISER 2008): best-first search over sets of\n"
+      "contacts driven by the guide potential of the scenario's key postures.\n"
+      "File mode: --in SCENARIO --out PLAN writes acyclic.plan/1; exit status 0 solved, 1 not solved\n"
+      "(reason printed), 2 bad input.\n"
+      "LCM mode: --lcm serves ACYCLIC_REQUEST and answers ACYCLIC_PLAN (with the request id), with\n"
+      "ACYCLIC_PROGRESS during the search, ACYCLIC_STATUS at 1 Hz and on every error, and ACYCLIC_CANCEL.\n"
+      "One request at a time: a request that arrives while one runs is refused (ACYCLIC_PLAN with\n"
+      "status ERROR and the reason, and a status error). Exits 0 on SIGINT/SIGTERM."};
+  std::string in, out, url = acyclic::proc::defaultLcmUrl();
+  bool lcm_mode = false;
+  acyclic::PlannerOverrides o;
+  bool quiet = false;
+  app.add_option("--in", in, "scenario file (acyclic.scenario/1), file mode");
+  app.add_option("--out", out, "plan file to write (acyclic.plan/1), file mode");
+  app.add_flag("--lcm", lcm_mode, "serve requests on LCM instead of the file mode");
+  app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
+  app.add_option("--seed", o.seed, "overrides the scenario's (and the request's) seed");
+  app.add_option("--max-seconds", o.max_seconds,
+                 "wall-time budget (default: the request's, else the scenario's planner section, else 60)");
+  app.add_option("--max-nodes", o.max_nodes, "nodes generated at most (default: scenario, else 1000)");
+  app.add_option("--max-posture-calls", o.max_posture_calls, "posture-generator calls at most (default: scenario, else 20000)");
+  app.add_flag("--eager-sons", o.eager_sons, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
+  app.add_flag("--random-candidates", o.random_candidates,
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");
-  app.add_flag("--distance-to-goal", goal_distance, "ablation: distance to the goal instead of the guide potential");
+  app.add_flag("--distance-to-goal", o.distance_to_goal, "ablation: distance to the goal instead of the guide potential");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   CLI11_PARSE(app, argc, argv);
 
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  acyclic::proc::installSignalHandlers();
+  if (lcm_mode) {
+    if (!in.empty() || !out.empty()) {
+      std::fprintf(stderr, "acyclic-planner: --lcm and --in/--out exclude each other\n");
+      return 2;
+    }
+    return acyclic::servePlanner(url, o);
+  }
+  if (in.empty() || out.empty()) {
+    std::fprintf(stderr, "acyclic-planner: give --in SCENARIO --out PLAN (file mode) or --lcm; see --help\n");
+    return 2;
+  }
   try {
     acyclic::Scenario sc = acyclic::Scenario::load(in);
-    if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
-    acyclic::PlannerParameters p = acyclic::plannerParameters(sc);
-    if (max_seconds > 0) p.max_seconds = max_seconds;
-    if (max_nodes > 0) p.max_nodes = max_nodes;
-    if (max_calls > 0) p.max_posture_calls = max_calls;
-    p.lazy_sons = !eager;
-    p.optimized_candidates = !random_candidates;
-    p.guide_potential = !goal_distance;
+    const acyclic::PlannerParameters p = o.apply(sc, -1);
     acyclic::ContactPlanner planner(sc, p);
     const bool tty = !quiet && isatty(STDERR_FILENO);
     auto progress = [&](const acyclic::PlanningStats& s) {
@@ -57,7 +67,7 @@ int main(int argc, char** argv) {
                    s.seconds, s.nodes_generated, s.nodes_expanded, s.posture_calls, s.posture_failures,
                    s.best_potential);
     };
-    const acyclic::PlanningResult r = planner.plan(&g_cancel, progress);
+    const acyclic::PlanningResult r = planner.plan(&acyclic::proc::stopFlag(), progress);
     if (tty) std::fprintf(stderr, "\n");
     const auto& s = r.stats;
     std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated, %ld expanded, %ld posture calls (%ld failed)\n",

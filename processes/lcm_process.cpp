@@ -58,7 +58,6 @@ StatusReporter::StatusReporter(Bus& bus, std::string process) : bus_(bus) {
   msg_.pid = getpid();
   msg_.request_id = -1;
   msg_.state = process_status_t::IDLE;
-  publish();
 }
 
 void StatusReporter::publish() {
@@ -67,6 +66,11 @@ void StatusReporter::publish() {
   msg_.errors = errors_;
   last_publish_us_ = msg_.utime;
   bus_.publish(channels::kStatus, msg_);
+}
+
+void StatusReporter::ready() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  publish();
 }
 
 void StatusReporter::idle() {
@@ -122,6 +126,39 @@ int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<boo
     if (on_tick) on_tick();
   }
   return 0;
+}
+
+bool Worker::start(std::int64_t request_id, std::function<void(const std::atomic<bool>&)> job) {
+  if (running_) return false;
+  reap();
+  cancel_ = false;
+  current_ = request_id;
+  running_ = true;
+  thread_ = std::thread([this, job = std::move(job)] {
+    job(cancel_);
+    running_ = false;
+  });
+  return true;
+}
+
+bool Worker::cancel(std::int64_t request_id) {
+  if (!running_ || (request_id != -1 && request_id != current_)) return false;
+  cancel_ = true;
+  return true;
+}
+
+void Worker::reap() {
+  if (!running_ && thread_.joinable()) {
+    thread_.join();
+    current_ = -1;
+  }
+}
+
+void Worker::stop() {
+  cancel_ = true;
+  if (thread_.joinable()) thread_.join();
+  running_ = false;
+  current_ = -1;
 }
 
 }  // namespace acyclic::proc

@@ -10,6 +10,7 @@
 #include <functional>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include "acyclic/process_status_t.hpp"
 
@@ -49,6 +50,9 @@ class Bus {
 class StatusReporter {
  public:
   StatusReporter(Bus& bus, std::string process);
+  // The first status: call it once the process has subscribed to its inputs,
+  // since others take a process's first status as "ready for requests".
+  void ready();
   void idle();
   void busy(std::int64_t request_id);
   // An error answering request_id (-1: none): status message and a log line.
@@ -68,6 +72,38 @@ class StatusReporter {
 };
 
 std::int64_t nowMicros();  // wall clock, for utime
+
+// Decodes a raw LCM message; a message that does not decode is reported
+// (status error naming the channel, and a log line) and false returned, so a
+// corrupt message never kills a process and never passes silently.
+template <class Msg>
+bool decode(const lcm::ReceiveBuffer* rb, const std::string& channel, Msg& out, StatusReporter& status) {
+  if (out.decode(rb->data, 0, static_cast<int>(rb->data_size)) >= 0) return true;
+  status.error(-1, channel + ": a message of " + std::to_string(rb->data_size) + " bytes does not decode as " +
+                       Msg::getTypeName());
+  return false;
+}
+
+// One request at a time, served on a worker thread while the LCM loop goes
+// on (heartbeat, cancellation). A second request while one runs is refused by
+// the caller (start() returns false): documented in each process's --help.
+class Worker {
+ public:
+  ~Worker() { stop(); }
+  // Starts job(cancel) for request_id on a thread; false when one is running.
+  bool start(std::int64_t request_id, std::function<void(const std::atomic<bool>& cancel)> job);
+  bool busy() const { return running_.load(); }
+  std::int64_t current() const { return current_.load(); }
+  // Cancels the running job if it serves request_id (or any job for -1).
+  bool cancel(std::int64_t request_id);
+  void reap();  // joins a finished job; call from the loop
+  void stop();  // cancels and joins
+
+ private:
+  std::thread thread_;
+  std::atomic<bool> running_{false}, cancel_{false};
+  std::atomic<std::int64_t> current_{-1};
+};
 
 // Serves LCM (handleTimeout) until a signal or until done() returns true,
 // calling on_tick() every period_ms. Returns 0, or 1 when LCM failed.

@@ -1,0 +1,250 @@
+// acyclic-launch: runs the whole pipeline on one machine (DESIGN.md section 2).
+// Starts lcm-logger and the pipeline's processes, sends the scenario as one
+// ACYCLIC_REQUEST, follows progress, writes what comes back (plan,
+// trajectory) under the output folder, restarts a process that dies (and
+// re-sends it the work it lost), and stops everything it started on exit or
+// on Ctrl-C. Exit: 0 all stages answered OK, 1 a stage failed or timed out,
+// 2 bad input.
+#include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "acyclic/plan_t.hpp"
+#include "acyclic/process_status_t.hpp"
+#include "acyclic/progress_t.hpp"
+#include "acyclic/request_t.hpp"
+#include "acyclic/trajectory_t.hpp"
+#include "lcmtypes/channels.hpp"
+#include "planner/common/format_error.h"
+#include "processes/lcm_convert.h"
+#include "processes/lcm_process.h"
+#include "processes/supervisor.h"
+
+namespace fs = std::filesystem;
+using namespace acyclic;
+
+namespace {
+
+void say(const std::string& s) {
+  std::printf("acyclic-launch: %s\n", s.c_str());
+  std::fflush(stdout);
+}
+
+// What the launcher hears on LCM.
+struct Listener {
+  std::int64_t request_id = 0;
+  std::map<std::string, int> status_seen;  // process -> status messages since (re)start
+  std::optional<plan_t> plan;
+  std::optional<trajectory_t> trajectory;
+  bool tty = false;
+
+  void onStatus(const lcm::ReceiveBuffer* rb, const std::string&, const process_status_t* m) {
+    ++status_seen[m->process];
+    if (m->state == process_status_t::ERROR)
+      say(m->process + " reports an error" +
+          (m->request_id >= 0 ? " on request " + std::to_string(m->request_id) : std::string()) + ": " + m->reason);
+  }
+  void onProgress(const lcm::ReceiveBuffer*, const std::string&, const progress_t* m) {
+    if (m->request_id != request_id || !tty) return;
+    std::fprintf(stderr, "\r%s %s: %6.1f s  nodes %ld  posture calls %ld  best %.3f  %s   ", m->source.c_str(),
+                 m->stage.c_str(), m->elapsed_s, static_cast<long>(m->nodes_generated),
+                 static_cast<long>(m->posture_calls), m->best_potential, m->message.c_str());
+  }
+  void onPlan(const lcm::ReceiveBuffer*, const std::string&, const plan_t* m) {
+    if (m->request_id == request_id) plan = *m;
+  }
+  void onTrajectory(const lcm::ReceiveBuffer*, const std::string&, const trajectory_t* m) {
+    if (m->request_id == request_id) trajectory = *m;
+  }
+};
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string selfDir() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : p.parent_path().string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Runs the Acyclic pipeline on one machine: lcm-logger, acyclic-planner and acyclic-interpolator\n"
+      "(each with --lcm), then sends the scenario as one ACYCLIC_REQUEST and waits for the plan and the\n"
+      "trajectory. Writes under --out: plan.json (acyclic.plan/1), trajectory.json\n"
+      "(acyclic.trajectory/1), run.lcmlog (every message of the run) and one log per process.\n"
+      "A process that dies is restarted (3 times at most) and given again the work it lost.\n"
+      "Everything started is stopped on exit and on Ctrl-C.\n"
+      "Exit status: 0 every stage answered OK, 1 a stage failed or timed out, 2 bad input.\n"
+      "Multicast: run it inside a private network namespace (scripts/run-pipeline does) or on a lab\n"
+      "network with ttl=1 (README, 'Across machines')."};
+  std::string scenario_path, out_dir = "acyclic-run", url = proc::defaultLcmUrl(), bin_dir = selfDir();
+  double timeout_s = 900;
+  long seed = -1;
+  double budget_s = -1;
+  std::int64_t request_id = 1;
+  bool no_interpolate = false, quiet = false;
+  std::vector<std::string> planner_args;
+  app.add_option("--scenario", scenario_path, "scenario file (acyclic.scenario/1)")->required();
+  app.add_option("--out", out_dir, "output folder (created)")->capture_default_str();
+  app.add_option("--lcm-url", url, "LCM URL for every process (default: $LCM_DEFAULT_URL, else LCM's default)");
+  app.add_option("--bin-dir", bin_dir, "where the acyclic-* executables are (default: beside this one)");
+  app.add_option("--timeout", timeout_s, "seconds to wait for the whole run")->capture_default_str();
+  app.add_option("--seed", seed, "request seed (default: the scenario's)");
+  app.add_option("--max-seconds", budget_s, "planning budget sent with the request (default: the scenario's)");
+  app.add_option("--request-id", request_id, "id of the request")->capture_default_str();
+  app.add_flag("--no-interpolate", no_interpolate, "stop after the plan");
+  app.add_option("--planner-arg", planner_args, "extra argument for acyclic-planner (repeatable)");
+  app.add_flag("-q,--quiet", quiet, "no progress line");
+  CLI11_PARSE(app, argc, argv);
+
+  Scenario sc;
+  try {
+    sc = Scenario::load(scenario_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "acyclic-launch: %s\n", e.what());
+    return 2;
+  }
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "acyclic-launch: cannot create %s: %s\n", out_dir.c_str(), ec.message().c_str());
+    return 2;
+  }
+  proc::installSignalHandlers();
+
+  Supervisor sup([](const std::string& s) { say(s); });
+  std::vector<std::string> stages = {"acyclic-planner"};
+  if (!no_interpolate) stages.push_back("acyclic-interpolator");
+  int rc = 1;
+  try {
+    proc::Bus bus(url);
+    Listener ear;
+    ear.request_id = request_id;
+    ear.tty = !quiet && isatty(STDERR_FILENO);
+    bus.lcm().subscribe(channels::kStatus, &Listener::onStatus, &ear);
+    bus.lcm().subscribe(channels::kProgress, &Listener::onProgress, &ear);
+    bus.lcm().subscribe(channels::kPlan, &Listener::onPlan, &ear);
+    bus.lcm().subscribe(channels::kTrajectory, &Listener::onTrajectory, &ear);
+
+    // The logger first, so that the log holds the whole run.
+    const std::string log_path = (fs::path(out_dir) / "run.lcmlog").string();
+    ChildSpec logger{"lcm-logger", {"/usr/bin/lcm-logger", "-f", "-q"}, (fs::path(out_dir) / "lcm-logger.log").string()};
+    if (!url.empty()) logger.argv.push_back("--lcm-url=" + url);
+    logger.argv.push_back(log_path);
+    sup.start(logger);
+    for (const auto& name : stages) {
+      ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--lcm"}, (fs::path(out_dir) / (name + ".log")).string()};
+      if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
+      if (name == "acyclic-planner") c.argv.insert(c.argv.end(), planner_args.begin(), planner_args.end());
+      sup.start(c);
+    }
+
+    request_t req{};
+    req.request_id = request_id;
+    req.scenario_name = sc.name;
+    req.scenario_yaml = readFile(scenario_path);
+    req.base_path = fs::absolute(scenario_path).parent_path().string();
+    req.seed = seed;
+    req.time_budget_s = budget_s;
+
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    auto allUp = [&] {
+      for (const auto& s : stages)
+        if (ear.status_seen[s] == 0) return false;
+      return true;
+    };
+    bool request_sent = false, plan_sent_on = false, failed = false, done = false;
+    bool lost_work_plan = false;
+    while (!proc::stopRequested() && !done && !failed) {
+      bus.lcm().handleTimeout(50);
+      for (const auto& name : sup.poll()) {
+        ear.status_seen[name] = 0;  // wait for the new instance's first status
+        if (name == "acyclic-planner" && request_sent && !ear.plan) request_sent = false;   // send again
+        if (name == "acyclic-interpolator" && ear.plan && !ear.trajectory) lost_work_plan = true;
+      }
+      if (elapsed() > timeout_s) {
+        say("timed out after " + std::to_string(static_cast<int>(timeout_s)) + " s");
+        failed = true;
+        break;
+      }
+      if (!request_sent) {
+        if (!allUp()) {
+          if (elapsed() > 30 && !ear.plan) {
+            say("the pipeline's processes did not report within 30 s (see the logs in " + out_dir + ")");
+            failed = true;
+          }
+          continue;
+        }
+        req.utime = proc::nowMicros();
+        bus.publish(channels::kRequest, req);
+        request_sent = true;
+        say("request " + std::to_string(request_id) + " sent: " + sc.name);
+      }
+      // The interpolator restarted after the plan went out: hand it the plan again.
+      if (lost_work_plan && ear.plan && ear.status_seen["acyclic-interpolator"] > 0) {
+        bus.publish(channels::kPlan, *ear.plan);
+        lost_work_plan = false;
+      }
+      if (ear.plan && !plan_sent_on) {
+        plan_sent_on = true;
+        if (ear.tty) std::fprintf(stderr, "\n");
+        const plan_t& m = *ear.plan;
+        say("plan: status " + std::to_string(m.status) + (m.reason.empty() ? "" : " (" + m.reason + ")") + ", " +
+            std::to_string(m.num_stances) + " stances, " + std::to_string(m.nodes_generated) + " nodes, " +
+            std::to_string(m.posture_calls) + " posture calls, " + std::to_string(m.seconds) + " s");
+        if (m.status != plan_t::OK) {
+          failed = true;
+          break;
+        }
+        const std::string plan_path = (fs::path(out_dir) / "plan.json").string();
+        Plan plan = convert::fromMessage(m, sc);
+        plan.scenario = fs::absolute(scenario_path).string();
+        writePlan(plan, sc, plan_path);
+        say("wrote " + plan_path);
+        if (no_interpolate) done = true;
+      }
+      if (ear.trajectory) {
+        const trajectory_t& m = *ear.trajectory;
+        if (ear.tty) std::fprintf(stderr, "\n");
+        if (m.status != trajectory_t::OK) {
+          say("trajectory: failed: " + m.reason);
+          failed = true;
+          break;
+        }
+        Trajectory tr = convert::fromMessage(m, sc);
+        tr.scenario = fs::absolute(scenario_path).string();
+        tr.plan = (fs::absolute(out_dir) / "plan.json").string();
+        const std::string tr_path = (fs::path(out_dir) / "trajectory.json").string();
+        writeTrajectory(tr, sc, tr_path);
+        say("wrote " + tr_path + " (" + std::to_string(m.num_samples) + " samples, " +
+            std::to_string(tr.duration()) + " s of motion)");
+        done = true;
+      }
+    }
+    if (proc::stopRequested()) say("interrupted: stopping every process");
+    rc = done ? 0 : (proc::stopRequested() ? 130 : 1);
+  } catch (const std::exception& e) {
+    say(std::string("error: ") + e.what());
+    rc = 1;
+  }
+  // Give lcm-logger a moment to write the last messages before it stops.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  sup.stopAll();
+  say("log of every message: " + (fs::path(out_dir) / "run.lcmlog").string());
+  return rc;
+}

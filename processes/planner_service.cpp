@@ -1,0 +1,188 @@
+#include "processes/planner_service.h"
+
+#include <memory>
+
+#include "acyclic/cancel_t.hpp"
+#include "acyclic/plan_t.hpp"
+#include "acyclic/progress_t.hpp"
+#include "acyclic/request_t.hpp"
+#include "lcmtypes/channels.hpp"
+#include "planner/search/planner_parameters.h"
+#include "processes/lcm_convert.h"
+#include "processes/lcm_process.h"
+
+namespace acyclic {
+
+PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s) const {
+  if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
+  PlannerParameters p = plannerParameters(sc);
+  if (request_budget_s > 0) p.max_seconds = request_budget_s;
+  if (max_seconds > 0) p.max_seconds = max_seconds;
+  if (max_nodes > 0) p.max_nodes = max_nodes;
+  if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
+  p.lazy_sons = !eager_sons;
+  p.optimized_candidates = !random_candidates;
+  p.guide_potential = !distance_to_goal;
+  return p;
+}
+
+namespace {
+
+const char* kProcess = "acyclic-planner";
+
+int8_t planStatus(PlanningResult::Status s) {
+  switch (s) {
+    case PlanningResult::Status::Solved: return plan_t::OK;
+    case PlanningResult::Status::NoSolution: return plan_t::NO_SOLUTION;
+    case PlanningResult::Status::NodeBudget:
+    case PlanningResult::Status::PostureBudget: return plan_t::BUDGET_EXHAUSTED;
+    case PlanningResult::Status::TimeLimit: return plan_t::TIMEOUT;
+    case PlanningResult::Status::Cancelled: return plan_t::CANCELLED;
+    case PlanningResult::Status::InvalidInput: return plan_t::INVALID_INPUT;
+  }
+  return plan_t::ERROR;
+}
+
+class PlannerService {
+ public:
+  PlannerService(proc::Bus& bus, PlannerOverrides o) : bus_(bus), status_(bus, kProcess), overrides_(o) {
+    bus.lcm().subscribe(channels::kRequest, &PlannerService::onRequest, this);
+    bus.lcm().subscribe(channels::kCancel, &PlannerService::onCancel, this);
+    status_.ready();
+  }
+  void tick() {
+    worker_.reap();
+    status_.tick();
+  }
+  void stop() {
+    if (worker_.busy()) proc::log(kProcess, "stopping: cancelling request " + std::to_string(worker_.current()));
+    worker_.stop();
+    status_.stopping();
+  }
+
+ private:
+  // An answer without a plan: refused, invalid input, error.
+  void refuse(const request_t& req, int8_t code, const std::string& reason) {
+    status_.error(req.request_id, reason);
+    plan_t m{};
+    m.utime = proc::nowMicros();
+    m.request_id = req.request_id;
+    m.status = code;
+    m.reason = reason;
+    m.scenario_name = req.scenario_name;
+    bus_.publish(channels::kPlan, m);
+  }
+
+  void onRequest(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    request_t req;
+    if (!proc::decode(rb, channel, req, status_)) return;
+    if (worker_.busy()) {
+      refuse(req, plan_t::ERROR,
+             "refused: busy with request " + std::to_string(worker_.current()) + " (one request at a time)");
+      return;
+    }
+    auto sc = std::make_shared<Scenario>();
+    PlannerParameters params;
+    try {
+      *sc = Scenario::loadText(req.scenario_yaml,
+                               "request " + std::to_string(req.request_id) + " (" + req.scenario_name + ")",
+                               req.base_path);
+      if (req.seed >= 0) sc->seed = static_cast<std::uint64_t>(req.seed);
+      params = overrides_.apply(*sc, req.time_budget_s);
+    } catch (const std::exception& e) {
+      refuse(req, plan_t::INVALID_INPUT, std::string("the scenario does not load: ") + e.what());
+      return;
+    }
+    proc::log(kProcess, "request " + std::to_string(req.request_id) + ": planning " + sc->name);
+    status_.busy(req.request_id);
+    worker_.start(req.request_id, [this, req, sc, params](const std::atomic<bool>& cancel) {
+      plan_t m{};
+      try {
+        ContactPlanner planner(*sc, params);
+        std::int64_t last_progress = 0;
+        auto progress = [&](const PlanningStats& s) {
+          const std::int64_t now = proc::nowMicros();
+          if (now - last_progress < 250000) return;  // 4 Hz at most
+          last_progress = now;
+          progress_t p{};
+          p.utime = now;
+          p.request_id = req.request_id;
+          p.source = kProcess;
+          p.stage = "search";
+          p.fraction = params.max_seconds > 0 ? std::min(1.0, s.seconds / params.max_seconds) : -1;
+          p.nodes_generated = s.nodes_generated;
+          p.posture_calls = s.posture_calls;
+          p.best_potential = s.best_potential;
+          p.elapsed_s = s.seconds;
+          p.message = std::to_string(s.nodes_expanded) + " nodes expanded, " + std::to_string(s.posture_failures) +
+                      " posture calls failed";
+          bus_.publish(channels::kProgress, p);
+        };
+        const PlanningResult r = planner.plan(&cancel, progress);
+        if (r.solved()) {
+          Plan plan = r.plan;
+          plan.scenario = req.scenario_name;
+          m = convert::toMessage(plan, *sc);
+        }
+        m.status = planStatus(r.status);
+        m.reason = r.reason;
+        m.nodes_generated = r.stats.nodes_generated;
+        m.nodes_expanded = r.stats.nodes_expanded;
+        m.posture_calls = r.stats.posture_calls;
+        m.posture_failures = r.stats.posture_failures;
+        m.seconds = r.stats.seconds;
+        proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + toString(r.status) + " in " +
+                                std::to_string(r.stats.seconds) + " s, " + std::to_string(r.stats.nodes_generated) +
+                                " nodes" + (r.solved() ? ", " + std::to_string(m.num_stances) + " stances" : ""));
+        if (!r.solved()) status_.error(req.request_id, std::string(toString(r.status)) + ": " + r.reason);
+      } catch (const std::exception& e) {
+        m = plan_t{};
+        m.status = plan_t::ERROR;
+        m.reason = e.what();
+        status_.error(req.request_id, e.what());
+      }
+      m.utime = proc::nowMicros();
+      m.request_id = req.request_id;
+      m.scenario_name = req.scenario_name;
+      m.scenario_yaml = req.scenario_yaml;
+      m.base_path = req.base_path;
+      bus_.publish(channels::kPlan, m);
+      status_.served();
+      status_.idle();
+    });
+  }
+
+  void onCancel(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    cancel_t c;
+    if (!proc::decode(rb, channel, c, status_)) return;
+    if (worker_.cancel(c.request_id))
+      proc::log(kProcess, "request " + std::to_string(worker_.current()) + ": cancelled (" + c.reason + ")");
+    else
+      status_.error(c.request_id, "cancel: request " + std::to_string(c.request_id) + " is not running");
+  }
+
+  proc::Bus& bus_;
+  proc::StatusReporter status_;
+  PlannerOverrides overrides_;
+  proc::Worker worker_;
+};
+
+}  // namespace
+
+int servePlanner(const std::string& lcm_url, const PlannerOverrides& overrides) {
+  try {
+    proc::Bus bus(lcm_url);
+    PlannerService service(bus, overrides);
+    proc::log(kProcess, "serving " + std::string(channels::kRequest) + " on " +
+                            (lcm_url.empty() ? std::string("LCM's default URL") : lcm_url));
+    const int rc = proc::spin(bus, [&] { service.tick(); });
+    service.stop();
+    proc::log(kProcess, "stopped");
+    return rc;
+  } catch (const std::exception& e) {
+    proc::log(kProcess, std::string("fatal: ") + e.what());
+    return 1;
+  }
+}
+
+}  // namespace acyclic

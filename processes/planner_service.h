@@ -1,0 +1,24 @@
+#pragma once
+// The contact planner on LCM: ACYCLIC_REQUEST in, ACYCLIC_PLAN out, with
+// progress, status and cancellation (DESIGN.md section 2).
+#include <string>
+
+#include "planner/search/contact_planner.h"
+
+namespace acyclic {
+
+// Command-line overrides of a scenario's planner parameters (both modes).
+struct PlannerOverrides {
+  long seed = -1;
+  double max_seconds = -1;
+  long max_nodes = -1, max_posture_calls = -1;
+  bool eager_sons = false, random_candidates = false, distance_to_goal = false;
+  // The scenario's parameters with these overrides; a request's time budget
+  // (> 0) applies unless --max-seconds is given. Also sets sc.seed.
+  PlannerParameters apply(Scenario& sc, double request_budget_s) const;
+};
+
+// Serves until SIGINT/SIGTERM. Returns the process's exit status.
+int servePlanner(const std::string& lcm_url, const PlannerOverrides& overrides);
+
+}  // namespace acyclic
