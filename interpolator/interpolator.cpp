@@ -88,6 +88,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.max_iterations = opt.posture_iterations;
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
+  to.posture.ipopt_options = opt.posture_ipopt_options;
   TransitionSolver solver(sc, to);
   Trajectory& tr = res.trajectory;
   tr.scenario = plan.scenario;
@@ -107,6 +108,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
     report("filtering");
     fr = filterStances(plan, solver, cancel);
     tr.stats.posture_calls += fr.posture_calls;
+    res.posture_seconds += fr.posture_seconds;
     if (fr.cancelled) return fail(Status::Cancelled, "cancelled while filtering stances");
   } else {
     for (int k = 0; k < static_cast<int>(plan.stances.size()); ++k) fr.kept.push_back(k);
@@ -128,7 +130,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
     if (cancel && cancel->load()) return fail(Status::Cancelled, "cancelled");
     auto cached = fr.solved.find({d.from, d.to});
     TransitionOutcome o = cached != fr.solved.end() ? cached->second : solver.solve(plan, d, cancel);
-    if (cached == fr.solved.end()) tr.stats.posture_calls += o.posture_calls;
+    if (cached == fr.solved.end()) tr.stats.posture_calls += o.posture_calls, res.posture_seconds += o.posture_seconds;
     if (o.cancelled) return fail(Status::Cancelled, "cancelled");
     if (!o.ok) {
       res.failed_stances = {d.from, d.to};

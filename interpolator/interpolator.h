@@ -31,6 +31,7 @@ struct InterpolatorOptions {
   // Each posture call bounded by iterations, not time: same input, same output.
   int posture_iterations = 100;
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out
+  std::vector<std::string> posture_ipopt_options;  // "name=value", passed to each posture solve
 };
 
 struct InterpolationProgress {
@@ -48,6 +49,7 @@ struct InterpolationResult {
   Trajectory trajectory;                // on success
   int filtered = 0;                     // stances dropped
   int refinements = 0;                  // knots inserted between steps
+  double posture_seconds = 0;           // of the wall time, inside the posture generator
   bool success() const { return status == Status::Success; }
 };
 

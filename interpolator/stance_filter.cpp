@@ -16,6 +16,7 @@ FilterResult filterStances(const Plan& plan, TransitionSolver& solver, const std
         d[0].kind == TransitionDesign::Kind::Fixed) {
       TransitionOutcome o = solver.solve(plan, d[0], cancel);
       fr.posture_calls += o.posture_calls;
+      fr.posture_seconds += o.posture_seconds;
       if (o.cancelled) {
         fr.cancelled = true;
         return fr;

@@ -17,6 +17,7 @@ struct FilterResult {
   std::vector<int> kept;  // plan stance indices, in order
   int dropped = 0;
   long posture_calls = 0;
+  double posture_seconds = 0;
   bool cancelled = false;
   // The direct transitions that justified a drop, keyed by (from, to): reused.
   std::map<std::pair<int, int>, TransitionOutcome> solved;

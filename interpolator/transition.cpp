@@ -98,6 +98,7 @@ std::string designTransitions(const Plan& plan, const std::vector<int>& kept, st
 struct TransitionSolver::Attempt {
   const std::atomic<bool>* cancel = nullptr;
   long posture_calls = 0;
+  double posture_seconds = 0;
   int refinements = 0;
   std::string reason;
   bool cancelled = false;
@@ -197,6 +198,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   out.cancelled = at.cancelled;
   out.reason = at.cancelled ? "cancelled" : at.reason;
   out.posture_calls = at.posture_calls;
+  out.posture_seconds = at.posture_seconds;
   out.refinements = at.refinements;
   out.pieces = std::move(at.pieces);
   if (!out.ok) out.pieces.clear();
@@ -220,10 +222,12 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, A
     r.cost = std::make_shared<ReferencePostureCost>(ref);
     PostureResult res = generator_.solve(r);
     ++at.posture_calls;
+    at.posture_seconds += res.seconds;
     if (!res.success()) {  // from the interpolated witnesses instead of the previous step
       r.initial_guess = ref;
       res = generator_.solve(r);
       ++at.posture_calls;
+      at.posture_seconds += res.seconds;
     }
     if (!res.success()) {
       at.reason = "no posture at step " + std::to_string(alpha) + ": " + res.reason;
@@ -276,10 +280,12 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     r.cost = std::make_shared<ReferencePostureCost>(ref);
     PostureResult res = generator_.solve(r);
     ++at.posture_calls;
+    at.posture_seconds += res.seconds;
     if (!res.success()) {
       r.initial_guess = ref;
       res = generator_.solve(r);
       ++at.posture_calls;
+      at.posture_seconds += res.seconds;
     }
     if (!res.success()) {
       char buf[64];

@@ -73,6 +73,7 @@ struct TransitionOutcome {
   std::string reason;                // on failure
   std::vector<MotionPiece> pieces;
   long posture_calls = 0;
+  double posture_seconds = 0;        // wall time inside the posture generator
   bool repaired = false;
   int refinements = 0;               // knots inserted between the n steps
 };

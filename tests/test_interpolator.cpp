@@ -417,3 +417,45 @@ TEST(TrajectoryCheck, FindsEachKindOfViolation) {
   phases.samples[1].phase = 3;
   EXPECT_FALSE(checkTrajectory(phases, sc, checker).valid());
 }
+
+// --- The executables ----------------------------------------------------------------
+
+TEST(InterpolatorProcess, WritesATrajectoryThatAcyclicCheckAccepts) {
+  const Scenario& sc = floorScenario();
+  test::TempDir dir;
+  const std::string plan = dir.path() + "/step.json", traj = dir.path() + "/step.trajectory.json";
+  Plan p = stepPlan(sc, 0.15);
+  writePlan(p, sc, plan);
+  const std::string interp = test::binaryPath("processes/acyclic-interpolator");
+  const std::string check = test::binaryPath("processes/acyclic-check");
+  const auto run = test::runProcess(interp + " --in " + plan + " --out " + traj + " -n 10");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("samples"), std::string::npos) << run.output;
+  const auto ok = test::runProcess(check + " " + sc.path + " --trajectory " + traj);
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_NE(ok.output.find("trajectory: valid"), std::string::npos) << ok.output;
+  // The same trajectory with a held foot dragged 3 mm: a violation, exit 1.
+  Trajectory tr = readTrajectory(traj, sc);
+  for (auto& s : tr.samples) s.q.base_position.y() += s.t > 0.2 && s.t < 0.3 ? 0.003 : 0.0;
+  writeTrajectory(tr, sc, dir.path() + "/bad.json");
+  const auto bad = test::runProcess(check + " " + sc.path + " --trajectory " + dir.path() + "/bad.json");
+  EXPECT_EQ(bad.status, 1) << bad.output;
+  EXPECT_NE(bad.output.find("spot origin"), std::string::npos) << bad.output;
+}
+
+TEST(InterpolatorProcess, HelpAndBadInput) {
+  const std::string interp = test::binaryPath("processes/acyclic-interpolator");
+  const auto help = test::runProcess(interp + " --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.output.find("Exit status"), std::string::npos) << help.output;
+  test::TempDir dir;
+  const auto missing = test::runProcess(interp + " --in " + dir.path() + "/none.json --out " + dir.path() + "/t.json");
+  EXPECT_EQ(missing.status, 2) << missing.output;
+  EXPECT_NE(missing.output.find("none.json"), std::string::npos) << missing.output;
+  // A plan whose scenario field names no file: the file and the field are named.
+  const std::string plan = dir.write("p.json", R"({"format": "acyclic.plan/1", "scenario": "nowhere.yaml", "stances": []})");
+  const auto noscen = test::runProcess(interp + " --in " + plan + " --out " + dir.path() + "/t.json");
+  EXPECT_EQ(noscen.status, 2) << noscen.output;
+  EXPECT_NE(noscen.output.find("field 'scenario'"), std::string::npos) << noscen.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/t.json"));
+}

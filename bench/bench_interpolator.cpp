@@ -1,0 +1,83 @@
+// The trajectory interpolator on a plan: wall time (and its share in the
+// posture generator), posture calls, repairs, filtered stances, samples, for
+// n = 10 and 20 steps, with and without filtering; then the independent
+// trajectory check of the default run. Figures quoted in the README.
+// Usage: bench_interpolator [PLAN.json [SCENARIO]] [--cutoff M] [--ipopt name=value ...]
+//   Without a plan: plans models/scenarios/step_forward.yaml first. The
+//   scenario defaults to the plan's "scenario" field (relative to the
+//   current directory or the source tree).
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "interpolator/interpolator.h"
+#include "planner/check/trajectory_check.h"
+#include "planner/search/planner_parameters.h"
+
+using namespace acyclic;
+
+int main(int argc, char** argv) {
+  // Positional: plan, scenario; --ipopt name=value (repeatable) and --cutoff M for tuning.
+  std::vector<std::string> ipopt, positional;
+  double cutoff = InterpolatorOptions{}.collision_cutoff;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--ipopt" && i + 1 < argc) ipopt.push_back(argv[++i]);
+    else if (a == "--cutoff" && i + 1 < argc) cutoff = std::atof(argv[++i]);
+    else positional.push_back(a);
+  }
+  std::string plan_path = positional.size() > 0 ? positional[0] : "";
+  std::string scenario_path = positional.size() > 1 ? positional[1] : "";
+  Plan plan;
+  Scenario sc;
+  if (plan_path.empty()) {
+    sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/step_forward.yaml");
+    const PlanningResult r = ContactPlanner(sc, plannerParameters(sc)).plan();
+    if (!r.solved()) {
+      std::printf("bench_interpolator: the planner did not solve %s: %s\n", sc.name.c_str(), r.reason.c_str());
+      return 1;
+    }
+    plan = r.plan;
+    plan_path = "(planned: " + sc.path + ")";
+  } else {
+    if (scenario_path.empty()) {
+      std::ifstream in(plan_path);
+      const std::string s = nlohmann::json::parse(in).at("scenario").get<std::string>();
+      scenario_path = std::filesystem::exists(s) ? s : std::string(ACYCLIC_SOURCE_DIR "/") + s;
+    }
+    sc = Scenario::load(scenario_path);
+    plan = readPlan(plan_path, sc);
+  }
+  std::printf("plan %s: scenario %s, %zu stances\n", plan_path.c_str(), sc.name.c_str(), plan.stances.size());
+  std::printf("%3s %7s %-16s %9s %9s %7s %8s %8s %8s %8s %9s\n", "n", "filter", "result", "wall s", "posture s",
+              "calls", "repairs", "filtered", "refined", "samples", "motion s");
+  InterpolationResult keep;
+  for (int n : {10, 20})
+    for (bool filter : {false, true}) {
+      InterpolatorOptions o;
+      o.steps = n;
+      o.filter = filter;
+      o.posture_ipopt_options = ipopt;
+      o.collision_cutoff = cutoff;
+      InterpolationResult r = interpolate(plan, sc, o);
+      const auto& s = r.trajectory.stats;
+      std::printf("%3d %7s %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, filter ? "yes" : "no",
+                  toString(r.status), s.seconds, r.posture_seconds, s.posture_calls, s.repairs, r.filtered,
+                  r.refinements, r.trajectory.samples.size(), r.trajectory.duration());
+      if (!r.success()) std::printf("    reason: %s\n", r.reason.c_str());
+      std::fflush(stdout);
+      if (n == 20 && filter) keep = std::move(r);
+    }
+  if (keep.success()) {
+    ValidityChecker checker(sc.robot, sc.scene);
+    const TrajectoryReport rep = checkTrajectory(keep.trajectory, sc, checker);
+    std::printf("trajectory check (n = 20, filtered): %s, %d of %d samples valid, worst joint speed %.0f%% of its limit\n",
+                rep.valid() ? "valid" : "INVALID", rep.samples - rep.invalid_samples, rep.samples,
+                100 * rep.worst_velocity_ratio);
+  }
+  return 0;
+}
