@@ -15,6 +15,8 @@
 
 #include "interpolator/interpolator.h"
 #include "planner/common/format_error.h"
+#include "processes/lcm_process.h"
+#include "processes/interpolator_service.h"
 
 namespace {
 
@@ -52,11 +54,20 @@ int main(int argc, char** argv) {
       "raised automatically where it collides), a posture at each of n steps, useless stances filtered,\n"
       "timed within the joint velocity limits and a speed cap, at rest wherever a contact is made or\n"
       "broken, sampled every dt.\n"
-      "Exit status: 0 written, 1 not interpolated (reason printed, or cancelled), 2 bad input."};
+      "File mode: --in PLAN --out TRAJECTORY; exit status 0 written, 1 not interpolated (reason printed,\n"
+      "or cancelled), 2 bad input.\n"
+      "LCM mode: --lcm interpolates every ACYCLIC_PLAN with status OK and answers ACYCLIC_TRAJECTORY (same\n"
+      "request id), with ACYCLIC_PROGRESS, ACYCLIC_STATUS at 1 Hz and on errors, and ACYCLIC_CANCEL. One\n"
+      "plan at a time: a plan that arrives while one is interpolated is refused (ACYCLIC_TRAJECTORY with\n"
+      "status ERROR and the reason). Exits 0 on SIGINT/SIGTERM."};
   std::string in, out, scenario_path;
   bool no_filter = false, quiet = false;
-  app.add_option("--in", in, "plan file (acyclic.plan/1)")->required();
-  app.add_option("--out", out, "trajectory file to write (acyclic.trajectory/1)")->required();
+  bool lcm_mode = false;
+  std::string url = acyclic::proc::defaultLcmUrl();
+  app.add_option("--in", in, "plan file (acyclic.plan/1), file mode");
+  app.add_option("--out", out, "trajectory file to write (acyclic.trajectory/1), file mode");
+  app.add_flag("--lcm", lcm_mode, "serve ACYCLIC_PLAN on LCM instead of the file mode");
+  app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--scenario", scenario_path,
                  "scenario file (default: the plan's 'scenario' field, beside the plan, else in the current directory)");
   app.add_option("-n,--steps", o.steps, "posture-generator steps per transition")->capture_default_str();
@@ -69,6 +80,18 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   CLI11_PARSE(app, argc, argv);
   o.filter = !no_filter;
+  if (lcm_mode) {
+    if (!in.empty() || !out.empty()) {
+      std::fprintf(stderr, "acyclic-interpolator: --lcm and --in/--out exclude each other\n");
+      return 2;
+    }
+    acyclic::proc::installSignalHandlers();
+    return acyclic::serveInterpolator(url, o);
+  }
+  if (in.empty() || out.empty()) {
+    std::fprintf(stderr, "acyclic-interpolator: give --in PLAN --out TRAJECTORY (file mode) or --lcm; see --help\n");
+    return 2;
+  }
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
