@@ -8,6 +8,7 @@
 //   current directory or the source tree).
 #include <cstdio>
 #include <cstdlib>
+#include <malloc.h>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -21,6 +22,10 @@
 using namespace acyclic;
 
 int main(int argc, char** argv) {
+  // As acyclic-interpolator does: MUMPS's workspace stays in the heap between factorizations.
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  mallopt(M_TOP_PAD, 64 << 20);
   // Positional: plan, scenario; --ipopt name=value (repeatable) and --cutoff M for tuning.
   std::vector<std::string> ipopt, positional;
   double cutoff = InterpolatorOptions{}.collision_cutoff;

@@ -33,6 +33,7 @@ bool sameContacts(const std::vector<ContactSpec>& a, const std::vector<ContactSp
 
 std::string validateOptions(const InterpolatorOptions& o) {
   if (o.steps < 1) return "steps must be at least 1";
+  if (!(o.fixed_step >= 0)) return "the fixed-contact step must be non-negative";
   if (!(o.dt > 0)) return "dt must be positive";
   if (!(o.speed_cap > 0)) return "the speed cap must be positive";
   if (!(o.velocity_share > 0 && o.velocity_share <= 1)) return "the velocity share must be in (0, 1]";
@@ -79,6 +80,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
 
   TransitionOptions to;
   to.steps = opt.steps;
+  to.fixed_step = opt.fixed_step;
   to.lift = opt.lift;
   to.touch_clearance = opt.touch_clearance;
   to.air_orientation_tolerance = opt.air_orientation_tolerance;

@@ -17,7 +17,8 @@
 namespace acyclic {
 
 struct InterpolatorOptions {
-  int steps = 20;                // n: posture-generator steps per transition
+  int steps = 20;                // n: posture-generator steps per transition (moving body)
+  double fixed_step = 0.02;      // fixed-contact transitions: a step per 0.02 rad (m) of change, n at most; 0: n
   double dt = 0.005;             // s, the controller's period
   double speed_cap = 0.2;        // m/s, any link origin (quasi-static motion)
   double velocity_share = 0.9;   // of each joint's velocity limit

@@ -1,5 +1,6 @@
 #include "interpolator/transition.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -235,10 +236,15 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, A
     }
     return res.configuration;
   };
+  // A small motion (a weight shift) needs fewer steps than n: one per
+  // fixed_step of its largest coordinate change, n at most.
+  int steps = opt_.steps;
+  if (opt_.fixed_step > 0)
+    steps = std::clamp(static_cast<int>(std::ceil(distance(q0, q1) / opt_.fixed_step)), 1, opt_.steps);
   std::vector<double> params{0.0};
   std::vector<Configuration> knots{q0};
-  for (int i = 1; i < opt_.steps; ++i) {
-    const double alpha = static_cast<double>(i) / opt_.steps;
+  for (int i = 1; i < steps; ++i) {
+    const double alpha = static_cast<double>(i) / steps;
     const auto k = solveAt(alpha, knots.back());
     if (!k) return false;
     params.push_back(alpha);

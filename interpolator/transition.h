@@ -55,6 +55,9 @@ struct MotionPiece {
 
 struct TransitionOptions {
   int steps = 20;                    // n: knots per transition
+  // Fixed-contact transitions: one step per this much of the largest
+  // coordinate change between the witnesses (rad, m), n at most; 0: always n.
+  double fixed_step = 0.02;
   double lift = 0.03;                // m: straight part along each surface normal
   double touch_clearance = 5e-4;     // m: the body is off its surface beyond this (contract: 1 mm)
   // On the spline (in the air) the body's orientation follows the slerp only

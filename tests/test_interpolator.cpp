@@ -258,7 +258,7 @@ TEST(Interpolator, SingleFootStepOnTheFloor) {
   EXPECT_EQ(r.filtered, 0);
   EXPECT_EQ(tr.stats.transitions, 3);  // unload (fixed contacts), step (moving foot), load (no motion)
   EXPECT_EQ(tr.stats.repairs, 0);
-  EXPECT_GT(tr.stats.posture_calls, 2 * opt.steps - 2);
+  EXPECT_GE(tr.stats.posture_calls, opt.steps + 1);  // the step: touch knots and the n - 1 between
   expectValid(tr, sc);
   // Phases: both feet; right foot unloaded; left foot alone (stance 2); right foot touching ahead.
   ASSERT_EQ(tr.phases.size(), 4u);
@@ -308,6 +308,8 @@ TEST(Interpolator, HandReachesTheTableAndLeavesIt) {
   ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
   const Trajectory& tr = r.trajectory;
   EXPECT_EQ(tr.stats.transitions, 2);
+  // Seated, the plain spline from the hanging hand to the table top meets the table's edge.
+  EXPECT_GE(tr.stats.repairs, 1);
   expectValid(tr, sc);
   // The palm touches the table in the middle phase; over the table top and
   // within 2 cm of it, it is straight above its placement.
@@ -447,7 +449,7 @@ TEST(InterpolatorProcess, HelpAndBadInput) {
   const std::string interp = test::binaryPath("processes/acyclic-interpolator");
   const auto help = test::runProcess(interp + " --help");
   EXPECT_EQ(help.status, 0);
-  EXPECT_NE(help.output.find("Exit status"), std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("exit status 0 written"), std::string::npos) << help.output;
   test::TempDir dir;
   const auto missing = test::runProcess(interp + " --in " + dir.path() + "/none.json --out " + dir.path() + "/t.json");
   EXPECT_EQ(missing.status, 2) << missing.output;
