@@ -200,6 +200,10 @@ void Bridge::endCheck(std::int64_t request_id, PrepareResult result, std::int64_
         false);
 }
 
+void Bridge::refuse(std::int64_t request_id, const std::string& why, std::int64_t now) {
+  event(now, "refused request " + std::to_string(request_id) + ": " + why, true);
+}
+
 Command& Bridge::remember(Command c) {
   c.sequence = ++sequence_;
   sent_.push_back(c);
@@ -268,6 +272,15 @@ Command Bridge::streamCommand(std::int64_t now) {
 }
 
 std::optional<Command> Bridge::tick(std::int64_t now) {
+  if (last_tick_ < 0 || now - last_tick_ > us(1.5 * cfg_.dt)) {
+    if (last_tick_ >= 0) ++late_ticks_;
+    listening_since_ = now;
+  }
+  last_tick_ = now;
+  // A watchdog fires only after the bridge has been listening on time for
+  // its whole timeout: a stall of the bridge (or of the whole machine) is
+  // not the robot's silence.
+  auto listened = [&](double timeout) { return now - listening_since_ >= us(timeout); };
   switch (state_) {
     case BridgeState::Idle:
       return std::nullopt;
@@ -276,7 +289,7 @@ std::optional<Command> Bridge::tick(std::int64_t now) {
       if (before_check_ == BridgeState::Holding && last_) return holdCommand(now, CommandMode::Hold);
       return std::nullopt;
     case BridgeState::Streaming:
-      if (!stateFresh(now)) {
+      if (!stateFresh(now) && listened(cfg_.state_timeout)) {
         active_ = false;
         enter(BridgeState::Holding, now,
               measured_ ? fmt("holding: robot state stale (none for %.1f ms, limit %.1f ms)", ms(now - measured_at_),
@@ -285,7 +298,7 @@ std::optional<Command> Bridge::tick(std::int64_t now) {
               true);
         return last_ ? std::optional<Command>(holdCommand(now, CommandMode::Hold)) : std::nullopt;
       }
-      if (first_stream_seq_ >= 0 && now - ack_changed_at_ > us(cfg_.stall_timeout)) {
+      if (first_stream_seq_ >= 0 && now - ack_changed_at_ > us(cfg_.stall_timeout) && listened(cfg_.stall_timeout)) {
         active_ = false;
         enter(BridgeState::Holding, now,
               fmt("holding: stream stalled (the controller acknowledged no command for %.1f ms, limit %.1f ms)",

@@ -94,12 +94,19 @@ class Bridge {
   // have come in between).
   void endCheck(std::int64_t request_id, PrepareResult result, std::int64_t now);
 
+  // A trajectory refused before it reached the bridge (it did not convert:
+  // a NaN, an unknown joint): reported like any refusal, nothing changes.
+  void refuse(std::int64_t request_id, const std::string& why, std::int64_t now);
+
   // One control period: the command to send, if any (none while idle: the
   // controller keeps its own reference).
   std::optional<Command> tick(std::int64_t now);
 
   BridgeStatus status(std::int64_t now) const;
   std::vector<BridgeEvent> takeEvents();
+
+  // Ticks that came more than 1.5 periods after the previous one.
+  long lateTicks() const { return late_ticks_; }
 
   // The prepared trajectory being (or last) streamed.
   const PreparedTrajectory& trajectory() const { return traj_; }
@@ -135,6 +142,13 @@ class Bridge {
   bool active_ = false;                   // a trajectory is under way (streaming or interrupted by an e-stop)
   std::int64_t blend_start_ = -1;         // e-stop release: speed ramp start
   std::int64_t stream_start_ = 0;
+
+  // The bridge's own timeliness: a tick more than 1.5 periods after the
+  // previous one means the bridge itself was not running (the machine
+  // stalled); the watchdogs then wait for a full timeout of on-time ticks
+  // before they blame the robot, whose states were queued meanwhile.
+  std::int64_t last_tick_ = -1, listening_since_ = -1;
+  long late_ticks_ = 0;
 
   // Commands.
   std::int64_t sequence_ = 0, commands_sent_ = 0, last_command_at_ = -1;

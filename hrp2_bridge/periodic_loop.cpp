@@ -1,6 +1,10 @@
 #include "hrp2_bridge/periodic_loop.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <stdexcept>
 
@@ -15,6 +19,20 @@ std::int64_t monotonicMicros() {
   timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);
   return toNs(t) / 1000;
+}
+
+bool setRealtimePriority(int priority, std::string* why) {
+  sched_param p{};
+  p.sched_priority = priority;
+  const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+  if (e != 0 && why) *why = std::strerror(e);
+  return e == 0;
+}
+
+void setBackgroundPriority(bool realtime) {
+  sched_param p{};
+  p.sched_priority = realtime ? 1 : 0;
+  pthread_setschedparam(pthread_self(), realtime ? SCHED_FIFO : SCHED_OTHER, &p);
 }
 
 PeriodicLoop::PeriodicLoop(double period_s) : period_ns_(std::llround(period_s * 1e9)) {

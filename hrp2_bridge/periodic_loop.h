@@ -6,11 +6,24 @@
 // time as an argument and reads no clock.
 #include <cstdint>
 #include <ctime>
+#include <string>
 
 namespace acyclic::hrp2 {
 
 // CLOCK_MONOTONIC in microseconds.
 std::int64_t monotonicMicros();
+
+// The calling thread to SCHED_FIFO at `priority` (1..99): a control loop that
+// sleeps almost all the time and must wake on time on a busy machine. Threads
+// created afterwards inherit it. False (with the reason) when not permitted.
+bool setRealtimePriority(int priority, std::string* why = nullptr);
+// For the heavy threads of a real-time process (checks, LPs): SCHED_FIFO 1,
+// below the loops, when `realtime`; else the normal time-sharing policy.
+// Not SCHED_OTHER in a real-time process: a time-shared thread preempted
+// while it holds a lock the loop needs (malloc's arena lock, freeing memory
+// across threads) stalled the loop for 10-30 ms on a loaded machine; at
+// FIFO 1 it gets the CPU back at once and releases it.
+void setBackgroundPriority(bool realtime);
 
 class PeriodicLoop {
  public:

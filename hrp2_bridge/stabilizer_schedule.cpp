@@ -67,9 +67,9 @@ StabilizerSchedule scheduleStabilizer(const Trajectory& tr, const RobotModel& m,
     if (s.sample_on[i] == before) continue;
     char why[160];
     if (s.sample_on[i])
-      std::snprintf(why, sizeof why, "on: only coplanar feet since t = %.3f s", off[cause[i - 1]].second);
+      std::snprintf(why, sizeof why, "only coplanar feet since t = %.3f s", off[cause[i - 1]].second);
     else
-      std::snprintf(why, sizeof why, "off: non-coplanar contact made at t = %.3f s", off[cause[i]].first);
+      std::snprintf(why, sizeof why, "non-coplanar contact made at t = %.3f s", off[cause[i]].first);
     s.switches.push_back({tr.samples[i].t, s.sample_on[i], why});
   }
   return s;

@@ -14,12 +14,11 @@ void SimOptions::validate() const {
   if (!(time_constant > 0)) bad("time_constant: expected a positive time (s)");
   if (!(latency >= 0)) bad("latency: expected a non-negative time (s)");
   if (!(drop_rate >= 0 && drop_rate < 1)) bad("drop_rate: expected a fraction in [0, 1)");
-  if (wrench_every < 1) bad("wrench_every: expected at least 1");
 }
 
-SimulatedController::SimulatedController(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
-                                         const Configuration& start, SimOptions options)
-    : robot_(robot), opt_(options), forces_(robot, scene), q_(start), rng_(options.seed) {
+SimulatedController::SimulatedController(std::shared_ptr<const RobotModel> robot, const Configuration& start,
+                                         SimOptions options)
+    : robot_(robot), opt_(options), q_(start), rng_(options.seed) {
   opt_.validate();
   if (start.joints.size() != robot->numJoints()) throw std::invalid_argument("simulator: start has the wrong joint count");
   dq_ = Eigen::VectorXd::Zero(robot->numJoints());
@@ -96,7 +95,7 @@ void SimulatedController::step(std::int64_t now) {
   }
 }
 
-SimState SimulatedController::state() {
+SimState SimulatedController::state() const {
   SimState s;
   if (has_command_) {
     s.request_id = current_.request_id;
@@ -106,9 +105,6 @@ SimState SimulatedController::state() {
   s.q = q_.joints;
   s.dq = dq_;
   s.configuration = q_;
-  if (states_++ % opt_.wrench_every == 0) wrenches_ = forces_.compute(q_, &equilibrium_);
-  s.wrenches = wrenches_;
-  s.equilibrium = equilibrium_;
   s.servo_on = opt_.servo_on;
   return s;
 }

@@ -2,10 +2,11 @@
 // A simulated HRP-2 controller (no LCM, no clock: `now` in microseconds is
 // passed in): position-controlled joints that track the latest command with
 // a first-order law and velocity feed-forward, within the model's velocity
-// limits; the base follows the streamed waist reference with the same law;
-// contact forces from the quasi-static model at the contacts found
-// geometrically (contact_forces.h). Fault options: latency, dropped
-// commands, a freeze (the controller hangs: no motion, no state).
+// limits; the base follows the streamed waist reference with the same law.
+// Contact forces come from the quasi-static model (contact_forces.h); the LP
+// takes milliseconds, so the caller computes them off the control loop and
+// attaches them to the state. Fault options: latency, dropped commands, a
+// freeze (the controller hangs: no motion, no state).
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -27,7 +28,6 @@ struct SimOptions {
   double drop_rate = 0;            // fraction of commands lost (seeded: deterministic)
   std::uint64_t seed = 1;
   double freeze_after = -1;        // s after the first command the controller hangs; < 0: never
-  int wrench_every = 10;           // contact forces every this many periods (the LP is the costly part)
   bool servo_on = true;
   void validate() const;           // std::invalid_argument naming the bad value
 };
@@ -44,15 +44,14 @@ struct SimState {
   std::int64_t request_id = -1, command_sequence = -1;
   Eigen::VectorXd q, dq;
   Configuration configuration;     // base pose and joints
-  std::vector<ContactWrench> wrenches;
+  std::vector<ContactWrench> wrenches;  // attached by the caller (ContactForces)
   bool equilibrium = false;        // the quasi-static LP found forces
   bool servo_on = true, stabilizer = true;
 };
 
 class SimulatedController {
  public:
-  SimulatedController(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
-                      const Configuration& start, SimOptions options);
+  SimulatedController(std::shared_ptr<const RobotModel> robot, const Configuration& start, SimOptions options);
 
   // A command arrives (dropped or delayed as the options say). A command of
   // the wrong size or not finite is ignored and counted: a real controller
@@ -63,7 +62,7 @@ class SimulatedController {
   void step(std::int64_t now);
   // True once the freeze time has passed: no motion, no state.
   bool frozen(std::int64_t now) const;
-  SimState state();
+  SimState state() const;
 
   long received() const { return received_; }
   long dropped() const { return dropped_; }
@@ -76,7 +75,6 @@ class SimulatedController {
 
   std::shared_ptr<const RobotModel> robot_;
   SimOptions opt_;
-  ContactForces forces_;
   Configuration q_;
   Eigen::VectorXd dq_;
   Eigen::VectorXd vmax_;
@@ -86,9 +84,6 @@ class SimulatedController {
   std::int64_t first_command_at_ = -1, last_step_ = -1;
   std::mt19937_64 rng_;
   long received_ = 0, dropped_ = 0, rejected_ = 0, applied_ = 0;
-  long states_ = 0;
-  std::vector<ContactWrench> wrenches_;
-  bool equilibrium_ = false;
 };
 
 }  // namespace acyclic::hrp2

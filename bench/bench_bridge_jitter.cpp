@@ -1,0 +1,164 @@
+// bench_bridge_jitter: the HRP-2 bridge's command stream timing. Runs the
+// bridge's own control loop (PeriodicLoop: clock_nanosleep on absolute
+// CLOCK_MONOTONIC deadlines) at the controller rate with the bridge's real
+// work each period (Bridge::tick on a streamed trajectory, the command
+// encoded as HRP2_COMMAND), and prints the period jitter: how late each
+// wake-up is after its deadline, and how far each period is from dt
+// (median, 99th percentile, max), with an optional load on the other core:
+// a busy loop, or the contact planner solving step_forward over and over.
+// Not a Google Benchmark: the figure is a distribution over a fixed time.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <signal.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+#include "acyclic/hrp2_command_t.hpp"
+#include "hrp2_bridge/bridge.h"
+#include "hrp2_bridge/periodic_loop.h"
+#include "planner/scene/scenario.h"
+
+using namespace acyclic;
+
+namespace {
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(std::floor(q * (v.size() - 1) + 0.5)))];
+}
+
+// A slow arm motion from the chair's start posture, long enough for the run.
+Trajectory motion(const Scenario& sc, double duration, double dt) {
+  Trajectory tr;
+  tr.dt = dt;
+  TrajectoryPhase p;
+  p.contacts = sc.start_stance;
+  p.t_end = duration;
+  tr.phases = {p};
+  const int n = static_cast<int>(std::lround(duration / dt));
+  for (int i = 0; i <= n; ++i) {
+    TrajectorySample s;
+    s.t = i * dt;
+    s.q = sc.start;
+    const double a = M_PI * s.t / duration;
+    s.q.joints[16] -= 0.4 * (1 - std::cos(a)) / 2;
+    s.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
+    s.dq[16] = -0.4 * M_PI / duration * std::sin(a) / 2;
+    tr.samples.push_back(s);
+  }
+  return tr;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Period jitter of the HRP-2 bridge's command loop (median, p99, max), optionally under load."};
+  double seconds = 20, dt = 0.005;
+  std::string load = "none";
+  int rt_priority = 20;
+  app.add_option("--seconds", seconds, "how long to run (default 20)");
+  app.add_option("--dt", dt, "controller period, s (default 0.005)");
+  app.add_option("--load", load, "none | busy (a spinning thread) | planner (acyclic-planner on step_forward, looped)")
+      ->check(CLI::IsMember({"none", "busy", "planner"}));
+  app.add_option("--rt-priority", rt_priority, "SCHED_FIFO priority of the loop, 0: none (default 20, as the bridge)");
+  CLI11_PARSE(app, argc, argv);
+
+  const Scenario sc = Scenario::load(std::string(ACYCLIC_SOURCE_DIR) + "/models/scenarios/chair_table.yaml");
+  hrp2::BridgeConfig cfg;
+  cfg.dt = dt;
+  hrp2::Bridge bridge(sc.robot, cfg);
+
+  std::atomic<bool> stop{false};
+  std::thread busy;
+  pid_t planner = -1;
+  if (load == "busy") {
+    busy = std::thread([&] {
+      volatile double x = 0;
+      while (!stop) x = x + 1;
+    });
+  } else if (load == "planner") {
+    planner = fork();
+    if (planner == 0) {
+      const std::string exe = std::string(ACYCLIC_BINARY_DIR) + "/processes/acyclic-planner";
+      const std::string in = std::string(ACYCLIC_SOURCE_DIR) + "/models/scenarios/step_forward.yaml";
+      for (;;) {
+        const pid_t c = fork();
+        if (c == 0) {
+          execl(exe.c_str(), exe.c_str(), "--in", in.c_str(), "--out", "/dev/null", "-q", (char*)nullptr);
+          _exit(127);
+        }
+        int st = 0;
+        waitpid(c, &st, 0);
+        if (!WIFEXITED(st) || WEXITSTATUS(st) == 127) _exit(1);
+      }
+    }
+  }
+
+  std::string rt = "normal priority";
+  if (rt_priority > 0) {
+    std::string why;
+    rt = hrp2::setRealtimePriority(rt_priority, &why) ? "SCHED_FIFO " + std::to_string(rt_priority)
+                                                     : "normal priority (SCHED_FIFO refused: " + why + ")";
+  }
+
+  // The bridge streams a trajectory against a robot that follows every command.
+  hrp2::MeasuredState robot;
+  robot.q = sc.start.joints;
+  robot.dq = Eigen::VectorXd::Zero(robot.q.size());
+  std::int64_t now = hrp2::monotonicMicros();
+  bridge.onState(robot, now);
+  bridge.beginCheck(1, now);
+  bridge.endCheck(1, hrp2::prepareTrajectory(motion(sc, seconds + 5, dt), sc.robot, sc.scene, cfg), now);
+  if (bridge.state() != hrp2::BridgeState::Streaming) {
+    std::fprintf(stderr, "bench_bridge_jitter: %s\n", bridge.status(now).reason.c_str());
+    return 1;
+  }
+
+  std::vector<double> late, period;  // us
+  std::vector<char> buf;
+  hrp2::PeriodicLoop loop(dt);
+  std::int64_t prev = -1;
+  const std::int64_t end = hrp2::monotonicMicros() + static_cast<std::int64_t>(seconds * 1e6);
+  while ((now = loop.wait()) < end) {
+    late.push_back(double(now - loop.deadline()));
+    if (prev >= 0) period.push_back(double(now - prev));
+    prev = now;
+    bridge.onState(robot, now);
+    if (auto c = bridge.tick(now)) {
+      hrp2_command_t m;
+      m.utime = now, m.request_id = c->request_id, m.sequence = c->sequence, m.mode = int8_t(c->mode);
+      m.num_joints = static_cast<int32_t>(c->q.size());
+      m.q.assign(c->q.data(), c->q.data() + c->q.size());
+      m.dq.assign(c->dq.data(), c->dq.data() + c->dq.size());
+      buf.resize(m.getEncodedSize());
+      m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      robot.q = c->q;
+      robot.command_sequence = c->sequence;
+      robot.request_id = c->request_id;
+    }
+  }
+  stop = true;
+  if (busy.joinable()) busy.join();
+  if (planner > 0) {
+    kill(-planner, SIGKILL);
+    kill(planner, SIGKILL);
+    waitpid(planner, nullptr, 0);
+  }
+  std::vector<double> dev;
+  for (double p : period) dev.push_back(std::abs(p - dt * 1e6));
+  std::printf("bench_bridge_jitter: %.0f s at %.0f Hz, load %s, %s, %zu periods, %ld skipped\n", seconds, 1 / dt,
+              load.c_str(), rt.c_str(), period.size(), loop.skipped());
+  std::printf("  wake-up after the deadline (us): median %.0f  p99 %.0f  max %.0f\n", quantile(late, 0.5),
+              quantile(late, 0.99), quantile(late, 1.0));
+  std::printf("  |period - dt| (us):              median %.0f  p99 %.0f  max %.0f\n", quantile(dev, 0.5),
+              quantile(dev, 0.99), quantile(dev, 1.0));
+  std::printf("  bridge state at the end: %s\n", hrp2::toString(bridge.state()));
+  return 0;
+}

@@ -1,0 +1,214 @@
+// acyclic-hrp2-sim: a simulated HRP-2 controller on LCM. Receives
+// HRP2_COMMAND, tracks it with position-controlled joints (first-order law,
+// velocity feed-forward, the model's velocity limits; hrp2_bridge/sim/),
+// publishes HRP2_STATE at the controller rate (joints, velocities, base pose,
+// contact wrenches from the quasi-static model). Fault options for tests:
+// latency, dropped commands, a freeze (the controller hangs).
+// Exit: 0 on SIGINT/SIGTERM or at --duration, 2 bad input, 3 LCM failure.
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "acyclic/hrp2_command_t.hpp"
+#include "acyclic/hrp2_state_t.hpp"
+#include "channels.hpp"
+#include "hrp2_bridge/periodic_loop.h"
+#include "hrp2_bridge/sim/simulated_controller.h"
+#include "hrp2_bridge/trajectory_file.h"
+#include "processes/lcm_process.h"
+
+namespace {
+
+const char* kName = "acyclic-hrp2-sim";
+
+acyclic::hrp2_state_t toMessage(const acyclic::hrp2::SimState& s) {
+  acyclic::hrp2_state_t m;
+  m.utime = acyclic::proc::nowMicros();
+  m.request_id = s.request_id;
+  m.command_sequence = s.command_sequence;
+  m.num_joints = static_cast<int32_t>(s.q.size());
+  m.q.assign(s.q.data(), s.q.data() + s.q.size());
+  m.dq.assign(s.dq.data(), s.dq.data() + s.dq.size());
+  for (int i = 0; i < 3; ++i) m.base_position[i] = s.configuration.base_position[i];
+  const Eigen::Quaterniond& o = s.configuration.base_orientation;
+  m.base_orientation[0] = o.w(), m.base_orientation[1] = o.x(), m.base_orientation[2] = o.y(), m.base_orientation[3] = o.z();
+  m.num_wrenches = static_cast<int32_t>(s.wrenches.size());
+  for (const auto& w : s.wrenches) {
+    m.wrench_names.push_back(w.name);
+    m.wrenches.emplace_back(w.wrench.data(), w.wrench.data() + 6);
+  }
+  m.servo_on = s.servo_on;
+  m.stabilizer = s.stabilizer;
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace acyclic;
+  CLI::App app{
+      "A simulated HRP-2 controller: subscribes HRP2_COMMAND, tracks it with position-controlled joints\n"
+      "(first-order law with velocity feed-forward, within the model's velocity limits; the base follows\n"
+      "the streamed waist reference), publishes HRP2_STATE at the controller rate with contact wrenches\n"
+      "from the quasi-static model. A command of the wrong size or with a NaN is ignored and counted.\n"
+      "Exit status: 0 on SIGINT/SIGTERM or after --duration, 2 bad input, 3 LCM failure."};
+  std::string scenario_path, start_trajectory, url = proc::defaultLcmUrl();
+  hrp2::SimOptions o;
+  double wrench_period = 0.05;
+  int rt_priority = 20;
+  bool servo_off = false;
+  double duration = 0;
+  app.add_option("--scenario", scenario_path, "scenario (robot, scene, start configuration)")->required();
+  app.add_option("--start-trajectory", start_trajectory,
+                 "start at this trajectory's first sample instead of the scenario's start");
+  app.add_option("--dt", o.dt, "controller period, s (default 0.005)");
+  app.add_option("--time-constant", o.time_constant, "joint tracking time constant, s (default 0.02)");
+  app.add_option("--latency", o.latency, "fault: apply each command this long after it arrives, s (default 0)");
+  app.add_option("--drop-rate", o.drop_rate, "fault: fraction of commands lost, seeded (default 0)");
+  app.add_option("--seed", o.seed, "seed of the dropped commands (default 1)");
+  app.add_option("--freeze-after", o.freeze_after,
+                 "fault: the controller hangs (no motion, no HRP2_STATE) this long after the first command, s");
+  app.add_option("--wrench-period", wrench_period,
+                 "contact wrenches (quasi-static LP, off the control loop) every this many s (default 0.05)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--servo-off", servo_off, "report the servos off (the bridge must refuse to start)");
+  app.add_option("--duration", duration, "exit after this many seconds (default: run until a signal)");
+  app.add_option("--rt-priority", rt_priority,
+                 "SCHED_FIFO priority of the control loop and LCM receive threads, 0: none (default 20; when not\n"
+                 "permitted the simulator says so and runs at normal priority)")
+      ->check(CLI::Range(0, 99));
+  app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
+  CLI11_PARSE(app, argc, argv);
+  o.servo_on = !servo_off;
+
+  std::unique_ptr<hrp2::SimulatedController> sim;
+  std::unique_ptr<hrp2::ContactForces> forces;
+  try {
+    o.validate();
+    Scenario sc = Scenario::load(scenario_path);
+    Configuration start = sc.start;
+    if (!start_trajectory.empty()) start = hrp2::loadTrajectoryFile(start_trajectory, scenario_path).trajectory.samples.at(0).q;
+    sim = std::make_unique<hrp2::SimulatedController>(sc.robot, start, o);
+    forces = std::make_unique<hrp2::ContactForces>(sc.robot, sc.scene);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", kName, e.what());
+    return 2;
+  }
+  proc::installSignalHandlers();
+  std::string rt_note = "normal priority";
+  if (rt_priority > 0) {
+    std::string why;
+    rt_note = hrp2::setRealtimePriority(rt_priority, &why) ? "SCHED_FIFO " + std::to_string(rt_priority)
+                                                          : "normal priority (SCHED_FIFO refused: " + why + ")";
+  }
+  std::unique_ptr<proc::Bus> bus;
+  try {
+    bus = std::make_unique<proc::Bus>(url);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", kName, e.what());
+    return 3;
+  }
+  proc::StatusReporter status(*bus, kName);
+  std::mutex mutex;
+  long bad_messages = 0;
+  const int n = static_cast<int>(sim->state().q.size());
+
+  struct Handler {
+    std::function<void(const lcm::ReceiveBuffer*)> f;
+    void handle(const lcm::ReceiveBuffer* rb, const std::string&) { f(rb); }
+  } on_command{[&](const lcm::ReceiveBuffer* rb) {
+    const std::int64_t now = hrp2::monotonicMicros();
+    hrp2_command_t m;
+    if (m.decode(rb->data, 0, static_cast<int>(rb->data_size)) < 0 || m.num_joints != n) {
+      if (bad_messages++ == 0)
+        status.error(-1, std::string(channels::kHrp2Command) + ": a command that does not decode or has " +
+                             std::to_string(m.num_joints) + " joints (the robot has " + std::to_string(n) +
+                             "): ignored (counted from now on)");
+      return;
+    }
+    hrp2::SimCommand c;
+    c.request_id = m.request_id, c.sequence = m.sequence, c.mode = m.mode;
+    c.q = Eigen::Map<const Eigen::VectorXd>(m.q.data(), n);
+    c.dq = Eigen::Map<const Eigen::VectorXd>(m.dq.data(), n);
+    c.waist_position = Eigen::Vector3d(m.waist_position);
+    c.waist_rpy = Eigen::Vector3d(m.waist_rpy);
+    c.stabilizer = m.stabilizer;
+    std::lock_guard<std::mutex> lock(mutex);
+    sim->receive(c, now);
+  }};
+  bus->lcm().subscribe(channels::kHrp2Command, &Handler::handle, &on_command);
+
+  std::atomic<bool> lcm_failed{false}, quit{false};
+  std::thread receiver([&] {
+    while (!proc::stopRequested() && !quit)
+      if (bus->lcm().handleTimeout(20) < 0 && !proc::stopRequested()) {
+        lcm_failed = true;
+        break;
+      }
+  });
+  // Contact wrenches: the LP takes milliseconds, so it runs on its own thread
+  // at its own rate and the control loop attaches the latest result.
+  std::mutex wrench_mutex;
+  std::vector<hrp2::ContactWrench> wrenches;
+  bool equilibrium = false;
+  std::thread wrench_thread([&] {
+    hrp2::setBackgroundPriority(rt_priority > 0);
+    hrp2::PeriodicLoop every(wrench_period);
+    while (!proc::stopRequested() && !quit) {
+      Configuration q;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        q = sim->state().configuration;
+      }
+      bool eq = false;
+      auto w = forces->compute(q, &eq);
+      {
+        std::lock_guard<std::mutex> lock(wrench_mutex);
+        wrenches = std::move(w);
+        equilibrium = eq;
+      }
+      every.wait();
+    }
+  });
+  proc::log(kName, "running at " + std::to_string(o.dt) + " s, " + rt_note +
+                       (o.latency > 0 ? ", latency " + std::to_string(o.latency) + " s" : "") +
+                       (o.drop_rate > 0 ? ", dropping " + std::to_string(o.drop_rate) : "") +
+                       (o.freeze_after >= 0 ? ", freezing " + std::to_string(o.freeze_after) + " s after the first command" : ""));
+  status.idle();
+  hrp2::PeriodicLoop loop(o.dt);
+  const std::int64_t t0 = hrp2::monotonicMicros();
+  bool announced_freeze = false;
+  while (!proc::stopRequested() && !lcm_failed) {
+    const std::int64_t now = loop.wait();
+    if (duration > 0 && now - t0 >= duration * 1e6) break;
+    std::optional<hrp2_state_t> msg;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      sim->step(now);
+      if (!sim->frozen(now)) {
+        hrp2::SimState st = sim->state();
+        std::lock_guard<std::mutex> wlock(wrench_mutex);
+        st.wrenches = wrenches;
+        st.equilibrium = equilibrium;
+        msg = toMessage(st);
+      }
+      else if (!announced_freeze) {
+        announced_freeze = true;
+        proc::log(kName, "frozen (fault option): no motion, no state from now on");
+      }
+    }
+    if (msg) bus->publish(channels::kHrp2State, *msg);
+    status.tick();
+  }
+  quit = true;
+  receiver.join();
+  wrench_thread.join();
+  status.stopping();
+  proc::log(kName, "commands: " + std::to_string(sim->received()) + " received, " + std::to_string(sim->applied()) +
+                       " applied, " + std::to_string(sim->dropped()) + " dropped, " + std::to_string(sim->rejected()) +
+                       " rejected, " + std::to_string(bad_messages) + " malformed");
+  return lcm_failed ? 3 : 0;
+}
