@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");
   app.add_flag("--distance-to-goal", o.distance_to_goal, "ablation: distance to the goal instead of the guide potential");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
+  app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   CLI11_PARSE(app, argc, argv);
 
   acyclic::proc::installSignalHandlers();

@@ -1,5 +1,6 @@
 #include "processes/planner_service.h"
 
+#include <cstdio>
 #include <memory>
 
 #include "acyclic/cancel_t.hpp"
@@ -23,6 +24,7 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   p.lazy_sons = !eager_sons;
   p.optimized_candidates = !random_candidates;
   p.guide_potential = !distance_to_goal;
+  if (verbose) p.trace = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   return p;
 }
 

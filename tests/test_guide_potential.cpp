@@ -96,7 +96,9 @@ TEST(GuidePotential, ValueGradientAndHessianAreContinuousAcrossJunctions) {
 }
 
 TEST(GuidePotential, GradientMatchesFiniteDifferences) {
-  const GuidePotential f(chair().key_postures, 1.0, 0.05);
+  // Joints weighted as the base (the paper) and lighter (guide_joint_weight).
+  for (const double w : {1.0, 0.1}) {
+  const GuidePotential f(chair().key_postures, 1.0, 0.05, w);
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> u(0, 1);
   for (int trial = 0; trial < 20; ++trial) {
@@ -109,8 +111,22 @@ TEST(GuidePotential, GradientMatchesFiniteDifferences) {
       b[i] -= h;
       num[i] = (f.value(a) - f.value(b)) / (2 * h);
     }
-    EXPECT_LT(test::relativeError(f.gradient(P), num), 1e-6) << "trial " << trial;
+    EXPECT_LT(test::relativeError(f.gradient(P), num), 1e-6) << "trial " << trial << ", joint weight " << w;
   }
+  }
+}
+
+TEST(GuidePotential, JointWeightScalesOnlyTheJointsDistance) {
+  const auto& keys = chair().key_postures;
+  const GuidePotential full(keys, 1.0, 0.05, 1.0), light(keys, 1.0, 0.05, 0.1);
+  // On the guide, the potential is -k s' whatever the weight; off it in the
+  // joints only, the distance term scales with the weight.
+  Eigen::VectorXd P = full.pointAt(0.3);
+  EXPECT_NEAR(full.value(P), light.value(P), 1e-12);
+  const double on = full.value(P);
+  P.tail(P.size() - 6).array() += 0.2;
+  EXPECT_NEAR(light.value(P) - on, 0.1 * (full.value(P) - on), 1e-9);
+  EXPECT_THROW(GuidePotential(keys, 1.0, 0.05, 0.0), std::invalid_argument);
 }
 
 TEST(GuidePotential, TangentGradientAsAPostureCost) {

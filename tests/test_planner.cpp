@@ -119,14 +119,19 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   const Scenario plain = Scenario::load(dir.write("a.yaml", text));
   EXPECT_EQ(plannerParameters(plain).max_nodes, PlannerParameters().max_nodes);
   const Scenario tuned =
-      Scenario::load(dir.write("b.yaml", text + "planner: {max_nodes: 77, box_half_sizes: [0.1, 0.2, 0.3]}\n"));
+      Scenario::load(dir.write("b.yaml", text + "planner: {max_nodes: 77, box_half_sizes: [0.1, 0.2, 0.3], guide_joint_weight: 0.1, "
+                                             "depth_weight: 0.02}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
+  EXPECT_DOUBLE_EQ(p.guide_joint_weight, 0.1);
+  EXPECT_DOUBLE_EQ(p.depth_weight, 0.02);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
            {"planner: {max_node: 5}\n", "planner.max_node"},
-           {"planner: {box_half_sizes: [0.1, -1, 0.3]}\n", "planner.box_half_sizes"}}) {
+           {"planner: {box_half_sizes: [0.1, -1, 0.3]}\n", "planner.box_half_sizes"},
+           {"planner: {depth_weight: -1}\n", "planner.depth_weight"},
+           {"planner: {guide_joint_weight: 0}\n", "planner.guide_joint_weight"}}) {
     const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
     try {
       plannerParameters(sc);

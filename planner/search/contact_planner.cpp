@@ -110,7 +110,7 @@ struct ContactPlanner::Impl {
     if (p.guide_potential) {
       std::vector<Configuration> keys = sc.key_postures;
       if (keys.size() < 2) throw std::invalid_argument("the guide potential needs key postures (at least two)");
-      guide = std::make_unique<GuidePotential>(keys, p.potential_k, p.smoothing_tolerance);
+      guide = std::make_unique<GuidePotential>(keys, p.potential_k, p.smoothing_tolerance, p.guide_joint_weight);
     }
   }
 
@@ -218,7 +218,9 @@ struct ContactPlanner::Impl {
     nodes.push_back(std::move(n));
     const int id = static_cast<int>(nodes.size()) - 1;
     if (sc.goal.satisfied(kin) && goal_node < 0) goal_node = id;
-    open.push({nodes[id].key, order++, id});
+    // The open list's order: f_T, plus (when set) a cost per contact change
+    // from the start, which lifts plateaus of equal f_T (weighted A*).
+    open.push({nodes[id].key + p.depth_weight * depth(id), order++, id});
     if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) stats.best_potential = nodes[id].key;
     return id;
   }
@@ -236,6 +238,10 @@ struct ContactPlanner::Impl {
       r.initial_guess = nodes[ni].q;
       r.cost = costFrom(nodes[ni].q);
       const PostureResult res = solve(r);
+      if (p.trace)
+        p.trace("  remove " + sc.robot->spots()[nodes[ni].contacts[c].spot].name + ": " + toString(res.status) +
+                " (" + std::to_string(res.iterations) + " it, " + std::to_string(res.seconds * 1e3).substr(0, 5) +
+                " ms)");
       if (!res.success()) continue;
       Node son;
       son.transition = r.contacts;
@@ -290,6 +296,10 @@ struct ContactPlanner::Impl {
         r.contacts.push_back(added);
       }
       const PostureResult res = solve(r);
+      if (p.trace)
+        p.trace("  add " + sc.robot->spots()[g.spot].name + "@" + sc.scene->surfaces()[g.surface].name + ": " +
+                toString(res.status) + " (" + std::to_string(res.iterations) + " it, " +
+                std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
       if (!res.success()) continue;  // that volume (or sample) holds no feasible contact
       if (p.optimized_candidates) added.placement = res.floating;
       Node son;
@@ -310,8 +320,30 @@ struct ContactPlanner::Impl {
     return -1;
   }
 
+  int depth(int ni) const {
+    int d = 0;
+    for (; nodes[ni].parent >= 0; ni = nodes[ni].parent) ++d;
+    return d;
+  }
+
+  void traceExpansion(int ni) {
+    if (!p.trace) return;
+    const Node& n = nodes[ni];
+    kin.setConfiguration(n.q);
+    const Eigen::Vector3d w = kin.linkPose(sc.goal.link).translation();
+    std::string line = "expand #" + std::to_string(ni) + " depth " + std::to_string(depth(ni)) + " key " +
+                       std::to_string(n.key) + " goal link (" + std::to_string(w.x()).substr(0, 6) + ", " +
+                       std::to_string(w.y()).substr(0, 6) + ", " + std::to_string(w.z()).substr(0, 6) + "):";
+    for (const auto& c : n.contacts) line += " " + sc.robot->spots()[c.spot].name + "@" +
+                                             sc.scene->surfaces()[c.surface].name;
+    line += "  [" + std::to_string(stats.nodes_generated) + " nodes, " + std::to_string(stats.posture_calls) +
+            " calls, " + std::to_string(elapsed()).substr(0, 6) + " s]";
+    p.trace(line);
+  }
+
   void expand(int ni) {
     ++stats.nodes_expanded;
+    traceExpansion(ni);
     removalSons(ni);
     if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return;
     for (int spot : sc.allowed_spots) {

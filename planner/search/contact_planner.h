@@ -29,6 +29,8 @@ namespace acyclic {
 struct PlannerParameters {
   double potential_k = 1.0;            // slope of f_T along the guide
   double smoothing_tolerance = 0.05;   // corner blends of the guide
+  double guide_joint_weight = 1.0;     // weight of the joints in |P - Q|^2 (the base's is 1)
+  double depth_weight = 0.0;           // added to a node's key per contact change from the start (0: the paper)
   BoxHalfSizes box;                    // subtracted around each candidate
   double duplicate_distance = 0.05;    // m: sons this close to a node (same contacts) are dropped
   double duplicate_angle = 0.35;       // rad
@@ -43,6 +45,8 @@ struct PlannerParameters {
   int eager_candidates_per_pair = 6;   // with lazy_sons = false: candidates per pair at expansion
   bool guide_potential = true;         // paper 2.7 (false: distance to the goal)
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
+  // Called with one line per expanded node (for -v); empty: silent.
+  std::function<void(const std::string&)> trace;
   PlannerParameters();
 };
 

@@ -95,8 +95,10 @@ Eigen::VectorXd GuidePotential::coordinates(const Configuration& q) {
   return P;
 }
 
-GuidePotential::GuidePotential(const std::vector<Configuration>& key_postures, double k, double tolerance)
-    : k_(k), tol_(tolerance) {
+GuidePotential::GuidePotential(const std::vector<Configuration>& key_postures, double k, double tolerance,
+                               double joint_weight)
+    : k_(k), tol_(tolerance), joint_weight_(joint_weight) {
+  if (!(joint_weight > 0)) throw std::invalid_argument("the guide's joint weight must be positive");
   if (key_postures.size() < 2) throw std::invalid_argument("the rough trajectory needs at least two key postures");
   if (!(tolerance > 0)) throw std::invalid_argument("the smoothing tolerance must be positive");
   for (const auto& q : key_postures) keys_.push_back(coordinates(q));
@@ -274,8 +276,10 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
 double GuidePotential::valueAndGradient(const Eigen::VectorXd& P, Eigen::VectorXd* grad) const {
   const Projection pr = project(P);
   const Eigen::VectorXd D = P - pr.Q;
-  if (grad) *grad = 2 * D - (2 * D.dot(pr.Q_s) + k_) * pr.grad_s;
-  return D.squaredNorm() - k_ * pr.s;
+  Eigen::VectorXd WD = D;  // the weighted difference: base weight 1, joints joint_weight_
+  WD.tail(n_ - 6) *= joint_weight_;
+  if (grad) *grad = 2 * WD - (2 * WD.dot(pr.Q_s) + k_) * pr.grad_s;
+  return D.dot(WD) - k_ * pr.s;
 }
 
 double GuidePotential::value(const Eigen::VectorXd& P) const { return valueAndGradient(P, nullptr); }
@@ -333,7 +337,9 @@ double GuidePotential::evaluate(const Kinematics& kin, Eigen::Ref<Eigen::VectorX
 }
 
 Eigen::VectorXd GuidePotential::diagonalHessian(int tangent_size) const {
-  return Eigen::VectorXd::Constant(tangent_size, 2.0);
+  Eigen::VectorXd h = Eigen::VectorXd::Constant(tangent_size, 2.0);
+  h.tail(tangent_size - 6) *= joint_weight_;
+  return h;
 }
 
 }  // namespace acyclic

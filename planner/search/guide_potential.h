@@ -29,7 +29,11 @@ class GuidePotential : public PostureCost {
  public:
   // Throws std::invalid_argument when fewer than two key postures are given,
   // or two consecutive ones share their base pose (T' must be one-to-one).
-  GuidePotential(const std::vector<Configuration>& key_postures, double k = 1.0, double tolerance = 0.05);
+  // joint_weight scales the joints' part of |P - Q|^2 (the base's weight is 1):
+  // below 1, the valley is about the base's path and leaves the limbs freer to
+  // reach contacts the key postures did not foresee.
+  GuidePotential(const std::vector<Configuration>& key_postures, double k = 1.0, double tolerance = 0.05,
+                 double joint_weight = 1.0);
 
   static Eigen::VectorXd coordinates(const Configuration& q);
 
@@ -78,6 +82,7 @@ class GuidePotential : public PostureCost {
   void rest(const Piece& p, double s_local, Eigen::VectorXd& r, Eigen::VectorXd& dr) const;
   std::vector<Piece> pieces_;
   double k_, tol_, length_ = 0;
+  double joint_weight_ = 1.0;
   int n_ = 0;  // full coordinate size
   std::vector<Eigen::VectorXd> keys_;
 };

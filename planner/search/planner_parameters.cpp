@@ -6,7 +6,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   PlannerParameters p;
   if (!sc.planner_section) return p;
   const YamlField& f = *sc.planner_section;
-  f.allowOnly({"potential_k", "smoothing_tolerance", "box_half_sizes", "duplicate_distance", "duplicate_angle",
+  f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations",
                "collision_margin"});
   auto positive = [&](const char* key, double& out) {
@@ -23,6 +23,12 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   };
   positive("potential_k", p.potential_k);
   positive("smoothing_tolerance", p.smoothing_tolerance);
+  positive("guide_joint_weight", p.guide_joint_weight);
+  positive("reach_slack", p.reach_slack);
+  if (f.has("depth_weight")) {
+    p.depth_weight = f["depth_weight"].number();
+    if (!(p.depth_weight >= 0)) f["depth_weight"].fail("a number >= 0");
+  }
   positive("duplicate_distance", p.duplicate_distance);
   positive("duplicate_angle", p.duplicate_angle);
   positive("max_seconds", p.max_seconds);
