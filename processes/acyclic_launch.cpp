@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   long seed = -1;
   double budget_s = -1;
   std::int64_t request_id = 1;
-  bool no_interpolate = false, quiet = false;
+  bool no_interpolate = false, quiet = false, external = false;
   std::vector<std::string> planner_args;
   app.add_option("--scenario", scenario_path, "scenario file (acyclic.scenario/1)")->required();
   app.add_option("--out", out_dir, "output folder (created)")->capture_default_str();
@@ -107,6 +107,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", budget_s, "planning budget sent with the request (default: the scenario's)");
   app.add_option("--request-id", request_id, "id of the request")->capture_default_str();
   app.add_flag("--no-interpolate", no_interpolate, "stop after the plan");
+  app.add_flag("--external", external,
+               "use pipeline processes already running (on this or other machines): start only lcm-logger");
   app.add_option("--planner-arg", planner_args, "extra argument for acyclic-planner (repeatable)");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
@@ -147,6 +149,7 @@ int main(int argc, char** argv) {
     logger.argv.push_back(log_path);
     sup.start(logger);
     for (const auto& name : stages) {
+      if (external) break;
       ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--lcm"}, (fs::path(out_dir) / (name + ".log")).string()};
       if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
       if (name == "acyclic-planner") c.argv.insert(c.argv.end(), planner_args.begin(), planner_args.end());
