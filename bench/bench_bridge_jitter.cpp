@@ -13,7 +13,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <sched.h>
 #include <signal.h>
+#include <spawn.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -23,6 +26,8 @@
 #include "hrp2_bridge/bridge.h"
 #include "hrp2_bridge/periodic_loop.h"
 #include "planner/scene/scenario.h"
+
+extern char** environ;
 
 using namespace acyclic;
 
@@ -62,12 +67,13 @@ int main(int argc, char** argv) {
   CLI::App app{"Period jitter of the HRP-2 bridge's command loop (median, p99, max), optionally under load."};
   double seconds = 20, dt = 0.005;
   std::string load = "none";
-  int rt_priority = 20;
+  int rt_priority = 20, cpu = -1;
   app.add_option("--seconds", seconds, "how long to run (default 20)");
   app.add_option("--dt", dt, "controller period, s (default 0.005)");
   app.add_option("--load", load, "none | busy (a spinning thread) | planner (acyclic-planner on step_forward, looped)")
       ->check(CLI::IsMember({"none", "busy", "planner"}));
   app.add_option("--rt-priority", rt_priority, "SCHED_FIFO priority of the loop, 0: none (default 20, as the bridge)");
+  app.add_option("--cpu", cpu, "pin the loop to this CPU, and the load to the others (default: no pinning)");
   CLI11_PARSE(app, argc, argv);
 
   const Scenario sc = Scenario::load(std::string(ACYCLIC_SOURCE_DIR) + "/models/scenarios/chair_table.yaml");
@@ -84,28 +90,42 @@ int main(int argc, char** argv) {
       while (!stop) x = x + 1;
     });
   } else if (load == "planner") {
-    planner = fork();
-    if (planner == 0) {
-      const std::string exe = std::string(ACYCLIC_BINARY_DIR) + "/processes/acyclic-planner";
-      const std::string in = std::string(ACYCLIC_SOURCE_DIR) + "/models/scenarios/step_forward.yaml";
-      for (;;) {
-        const pid_t c = fork();
-        if (c == 0) {
-          execl(exe.c_str(), exe.c_str(), "--in", in.c_str(), "--out", "/dev/null", "-q", (char*)nullptr);
-          _exit(127);
-        }
-        int st = 0;
-        waitpid(c, &st, 0);
-        if (!WIFEXITED(st) || WEXITSTATUS(st) == 127) _exit(1);
-      }
-    }
+    // A shell that runs the planner again and again (posix_spawn: nothing of
+    // this process is shared copy-on-write with it).
+    const std::string cmd = "while :; do '" + std::string(ACYCLIC_BINARY_DIR) + "/processes/acyclic-planner' --in '" +
+                            std::string(ACYCLIC_SOURCE_DIR) + "/models/scenarios/step_forward.yaml' --out /dev/null -q "
+                            ">/dev/null 2>&1; done";
+    const char* argv_sh[] = {"/bin/sh", "-c", cmd.c_str(), nullptr};
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setpgroup(&attr, 0);  // its own group: killed as one at the end
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+    if (posix_spawn(&planner, "/bin/sh", nullptr, &attr, const_cast<char* const*>(argv_sh), environ) != 0) planner = -1;
+    posix_spawnattr_destroy(&attr);
   }
-
+  if (cpu >= 0) {
+    cpu_set_t loop_set, others;
+    CPU_ZERO(&loop_set);
+    CPU_ZERO(&others);
+    CPU_SET(cpu, &loop_set);
+    for (int c = 0; c < CPU_SETSIZE && c < 64; ++c)
+      if (c != cpu) CPU_SET(c, &others);
+    if (planner > 0) sched_setaffinity(planner, sizeof others, &others);
+    sched_setaffinity(0, sizeof loop_set, &loop_set);  // the calling (loop) thread
+  }
+  if (busy.joinable() && cpu >= 0) {
+    cpu_set_t others;
+    CPU_ZERO(&others);
+    for (int c = 0; c < 64; ++c)
+      if (c != cpu) CPU_SET(c, &others);
+    pthread_setaffinity_np(busy.native_handle(), sizeof others, &others);
+  }
   std::string rt = "normal priority";
   if (rt_priority > 0) {
     std::string why;
     rt = hrp2::setRealtimePriority(rt_priority, &why) ? "SCHED_FIFO " + std::to_string(rt_priority)
                                                      : "normal priority (SCHED_FIFO refused: " + why + ")";
+    if (!hrp2::lockMemory(&why)) rt += " (memory not locked: " + why + ")";
   }
 
   // The bridge streams a trajectory against a robot that follows every command.
@@ -147,14 +167,14 @@ int main(int argc, char** argv) {
   stop = true;
   if (busy.joinable()) busy.join();
   if (planner > 0) {
-    kill(-planner, SIGKILL);
-    kill(planner, SIGKILL);
+    kill(-planner, SIGKILL);  // the shell and the planner it runs
     waitpid(planner, nullptr, 0);
   }
   std::vector<double> dev;
   for (double p : period) dev.push_back(std::abs(p - dt * 1e6));
-  std::printf("bench_bridge_jitter: %.0f s at %.0f Hz, load %s, %s, %zu periods, %ld skipped\n", seconds, 1 / dt,
-              load.c_str(), rt.c_str(), period.size(), loop.skipped());
+  std::printf("bench_bridge_jitter: %.0f s at %.0f Hz, load %s, %s, %s, %zu periods, %ld skipped\n", seconds, 1 / dt,
+              load.c_str(), rt.c_str(), cpu >= 0 ? ("loop on CPU " + std::to_string(cpu) + ", load on the others").c_str() : "no pinning",
+              period.size(), loop.skipped());
   std::printf("  wake-up after the deadline (us): median %.0f  p99 %.0f  max %.0f\n", quantile(late, 0.5),
               quantile(late, 0.99), quantile(late, 1.0));
   std::printf("  |period - dt| (us):              median %.0f  p99 %.0f  max %.0f\n", quantile(dev, 0.5),

@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/mman.h>
 
 #include <cerrno>
 #include <cstring>
@@ -27,6 +28,12 @@ bool setRealtimePriority(int priority, std::string* why) {
   const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
   if (e != 0 && why) *why = std::strerror(e);
   return e == 0;
+}
+
+bool lockMemory(std::string* why) {
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) return true;
+  if (why) *why = std::strerror(errno);
+  return false;
 }
 
 void setBackgroundPriority(bool realtime) {

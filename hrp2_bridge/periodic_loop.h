@@ -17,6 +17,10 @@ std::int64_t monotonicMicros();
 // sleeps almost all the time and must wake on time on a busy machine. Threads
 // created afterwards inherit it. False (with the reason) when not permitted.
 bool setRealtimePriority(int priority, std::string* why = nullptr);
+// Locks the process's memory (mlockall, current and future): a page fault
+// in a real-time loop costs milliseconds. False (with the reason) when not permitted.
+bool lockMemory(std::string* why = nullptr);
+
 // For the heavy threads of a real-time process (checks, LPs): SCHED_FIFO 1,
 // below the loops, when `realtime`; else the normal time-sharing policy.
 // Not SCHED_OTHER in a real-time process: a time-shared thread preempted

@@ -101,8 +101,13 @@ int main(int argc, char** argv) {
   std::string rt_note = "normal priority";
   if (rt_priority > 0) {
     std::string why;
-    rt_note = hrp2::setRealtimePriority(rt_priority, &why) ? "SCHED_FIFO " + std::to_string(rt_priority)
-                                                          : "normal priority (SCHED_FIFO refused: " + why + ")";
+    if (hrp2::setRealtimePriority(rt_priority, &why)) {
+      rt_note = "SCHED_FIFO " + std::to_string(rt_priority);
+      // No page faults in the loop: everything mapped now and later stays in memory.
+      rt_note += hrp2::lockMemory(&why) ? ", memory locked" : ", memory not locked (" + why + ")";
+    } else {
+      rt_note = "normal priority (SCHED_FIFO refused: " + why + ")";
+    }
   }
   std::unique_ptr<proc::Bus> bus;
   try {
