@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
                  "wall-time budget (default: the request's, else the scenario's planner section, else 60)");
   app.add_option("--max-nodes", o.max_nodes, "nodes generated at most (default: scenario, else 1000)");
   app.add_option("--max-posture-calls", o.max_posture_calls, "posture-generator calls at most (default: scenario, else 20000)");
+  app.add_option("--threads", o.threads,
+                 "posture generators run at once (default: scenario, else 2); the plan does not depend on it");
   app.add_flag("--eager-sons", o.eager_sons, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
   app.add_flag("--random-candidates", o.random_candidates,
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");

@@ -21,6 +21,7 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   if (max_seconds > 0) p.max_seconds = max_seconds;
   if (max_nodes > 0) p.max_nodes = max_nodes;
   if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
+  if (threads > 0) p.threads = threads;
   p.lazy_sons = !eager_sons;
   p.optimized_candidates = !random_candidates;
   p.guide_potential = !distance_to_goal;

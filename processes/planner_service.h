@@ -12,6 +12,7 @@ struct PlannerOverrides {
   long seed = -1;
   double max_seconds = -1;
   long max_nodes = -1, max_posture_calls = -1;
+  int threads = -1;
   bool eager_sons = false, random_candidates = false, distance_to_goal = false;
   bool verbose = false;  // one line per expanded node on stderr
   // The scenario's parameters with these overrides; a request's time budget

@@ -1,10 +1,12 @@
 #include "planner/search/contact_planner.h"
 
 #include <chrono>
+#include <cstdio>
 #include <deque>
 #include <cmath>
 #include <queue>
 #include <random>
+#include <thread>
 
 #include "planner/check/validity.h"
 #include "planner/search/guide_potential.h"
@@ -64,7 +66,7 @@ class GoalDistanceCost : public PostureCost {
 struct ContactPlanner::Impl {
   const Scenario& sc;
   PlannerParameters p;
-  PostureGenerator pg;
+  std::vector<std::unique_ptr<PostureGenerator>> pgs;  // one per thread
   ValidityChecker checker;
   Kinematics kin;  // the search is single-threaded: one for every key, goal and reach test
   std::unique_ptr<GuidePotential> guide;
@@ -105,8 +107,9 @@ struct ContactPlanner::Impl {
   std::string stop_reason;
 
   Impl(const Scenario& s, PlannerParameters params)
-      : sc(s), p(std::move(params)), pg(s.robot, s.scene, p.posture), checker(s.robot, s.scene), kin(s.robot),
-        rng(s.seed) {
+      : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), rng(s.seed) {
+    for (int t = 0; t < std::max(1, p.threads); ++t)
+      pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
     if (p.guide_potential) {
       std::vector<Configuration> keys = sc.key_postures;
       if (keys.size() < 2) throw std::invalid_argument("the guide potential needs key postures (at least two)");
@@ -150,12 +153,6 @@ struct ContactPlanner::Impl {
     return true;
   }
 
-  PostureResult solve(const PostureRequest& r) {
-    ++stats.posture_calls;
-    PostureResult res = pg.solve(r);
-    if (!res.success()) ++stats.posture_failures;
-    return res;
-  }
 
   static bool sameContacts(const std::vector<ContactSpec>& a, const std::vector<ContactSpec>& b, double dist,
                            double angle) {
@@ -204,6 +201,30 @@ struct ContactPlanner::Impl {
     return distance <= reach + p.reach_slack;
   }
 
+  int depth(int ni) const {
+    int d = 0;
+    for (; nodes[ni].parent >= 0; ni = nodes[ni].parent) ++d;
+    return d;
+  }
+
+  void traceExpansion(int ni) {
+    if (!p.trace) return;
+    const Node& n = nodes[ni];
+    kin.setConfiguration(n.q);
+    const Eigen::Vector3d w = kin.linkPose(sc.goal.link).translation();
+    std::string line = "expand #" + std::to_string(ni) + " depth " + std::to_string(depth(ni)) + " key " +
+                       std::to_string(n.key) + " goal link (" + std::to_string(w.x()).substr(0, 6) + ", " +
+                       std::to_string(w.y()).substr(0, 6) + ", " + std::to_string(w.z()).substr(0, 6) + "):";
+    char buf[64];
+    for (const auto& c : n.contacts) {
+      std::snprintf(buf, sizeof buf, "(%.2f,%.2f)", c.placement.x, c.placement.y);
+      line += " " + sc.robot->spots()[c.spot].name + "@" + sc.scene->surfaces()[c.surface].name + buf;
+    }
+    line += "  [" + std::to_string(stats.nodes_generated) + " nodes, " + std::to_string(stats.posture_calls) +
+            " calls, " + std::to_string(elapsed()).substr(0, 6) + " s]";
+    p.trace(line);
+  }
+
   // Adds a son if its witness passes the independent check and no node is too
   // close to it; returns its index or -1. Its key is computed here unless given.
   int addNode(Node n, bool key_given = false) {
@@ -225,10 +246,44 @@ struct ContactPlanner::Impl {
     return id;
   }
 
+  // Solves a batch of requests, on two generators at once when the planner
+  // has two (p.threads); results in request order. Request i always goes to
+  // generator i % threads, so the results do not depend on timing.
+  std::vector<PostureResult> solveAll(const std::vector<PostureRequest>& rs) {
+    std::vector<PostureResult> out(rs.size());
+    const std::size_t workers = std::min(pgs.size(), rs.size());
+    auto run = [&](std::size_t w) {
+      for (std::size_t i = w; i < rs.size(); i += workers) {
+        if (cancel && cancel->load()) break;  // left as BadInput: counted, never used
+        out[i] = pgs[w]->solve(rs[i]);
+      }
+    };
+    if (workers <= 1) {
+      run(0);
+    } else {
+      std::vector<std::thread> pool;
+      for (std::size_t w = 1; w < workers; ++w) pool.emplace_back(run, w);
+      run(0);
+      for (auto& t : pool) t.join();
+    }
+    for (const auto& r : out) {
+      ++stats.posture_calls;
+      if (!r.success()) ++stats.posture_failures;
+    }
+    return out;
+  }
+
+  void traceCall(const std::string& what, const PostureResult& res) const {
+    if (p.trace)
+      p.trace("  " + what + ": " + toString(res.status) + " (" + std::to_string(res.iterations) + " it, " +
+              std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
+  }
+
   void removalSons(int ni) {
-    const Node& n = nodes[ni];
-    if (n.contacts.size() < 2) return;
-    for (std::size_t c = 0; c < nodes[ni].contacts.size() && budgetLeft() && goal_node < 0; ++c) {
+    if (nodes[ni].contacts.size() < 2 || !budgetLeft()) return;
+    std::vector<PostureRequest> requests;
+    std::vector<std::size_t> removed;
+    for (std::size_t c = 0; c < nodes[ni].contacts.size(); ++c) {
       std::vector<ContactSpec> rest = nodes[ni].contacts;
       rest.erase(rest.begin() + c);
       if (isDuplicate(rest)) continue;  // known before any posture call
@@ -237,108 +292,104 @@ struct ContactPlanner::Impl {
       r.contacts[c].supporting = false;
       r.initial_guess = nodes[ni].q;
       r.cost = costFrom(nodes[ni].q);
-      const PostureResult res = solve(r);
-      if (p.trace)
-        p.trace("  remove " + sc.robot->spots()[nodes[ni].contacts[c].spot].name + ": " + toString(res.status) +
-                " (" + std::to_string(res.iterations) + " it, " + std::to_string(res.seconds * 1e3).substr(0, 5) +
-                " ms)");
-      if (!res.success()) continue;
+      requests.push_back(std::move(r));
+      removed.push_back(c);
+    }
+    const std::vector<PostureResult> results = solveAll(requests);
+    for (std::size_t k = 0; k < requests.size() && goal_node < 0; ++k) {
+      const std::size_t c = removed[k];
+      traceCall("remove " + sc.robot->spots()[nodes[ni].contacts[c].spot].name, results[k]);
+      if (!results[k].success()) continue;
       Node son;
-      son.transition = r.contacts;
+      son.transition = requests[k].contacts;
       son.contacts = nodes[ni].contacts;
       son.contacts.erase(son.contacts.begin() + c);
-      son.q = res.configuration;
+      son.q = results[k].configuration;
       son.parent = ni;
       son.change = Change::Removed;
       addNode(son);
     }
   }
 
+  // A pair generator's next request: its best remaining volume (or a random
+  // sample); false when it has none left.
+  struct Candidate {
+    PostureRequest request;
+    ContactSpec added;
+    SearchVolume volume;
+  };
+  bool nextCandidate(int gi, Candidate& cand) {
+    PairGenerator& g = gens[gi];
+    const Node& n = nodes[g.node];
+    PostureRequest& r = cand.request;
+    r = PostureRequest();
+    r.contacts = n.contacts;
+    r.initial_guess = n.q;
+    r.cost = costFrom(n.q);
+    ContactSpec& added = cand.added;
+    added = ContactSpec();
+    added.spot = g.spot;
+    added.surface = g.surface;
+    added.supporting = false;
+    if (p.optimized_candidates) {
+      if (g.volumes.empty()) return false;
+      // the volume whose parent candidate was best, first
+      std::size_t best = 0;
+      for (std::size_t k = 1; k < g.volumes.size(); ++k)
+        if (g.volumes[k].first < g.volumes[best].first) best = k;
+      cand.volume = g.volumes[best].second;
+      g.volumes.erase(g.volumes.begin() + best);
+      FloatingContact f;
+      f.spot = g.spot;
+      f.surface = g.surface;
+      f.volume = cand.volume;
+      r.floating = f;
+    } else {
+      if (g.samples_left-- <= 0) return false;
+      // the paper's earlier method: a random placement on the surface
+      const Surface& s = sc.scene->surfaces()[g.surface];
+      Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+      for (const auto& v : s.polygon.vertices()) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      std::uniform_real_distribution<double> u(0, 1);
+      do {
+        added.placement.x = lo.x() + (hi.x() - lo.x()) * u(rng);
+        added.placement.y = lo.y() + (hi.y() - lo.y()) * u(rng);
+      } while (!s.polygon.contains({added.placement.x, added.placement.y}));
+      added.placement.theta = -M_PI + 2 * M_PI * u(rng);
+      r.contacts.push_back(added);
+    }
+    return true;
+  }
+
+  // The son a candidate's result makes, or -1 (failed, duplicate, refused).
+  int acceptCandidate(int gi, Candidate& cand, const PostureResult& res) {
+    const PairGenerator& g = gens[gi];
+    traceCall("add " + sc.robot->spots()[g.spot].name + "@" + sc.scene->surfaces()[g.surface].name, res);
+    if (!res.success()) return -1;  // that volume (or sample) holds no feasible contact
+    if (p.optimized_candidates) cand.added.placement = res.floating;
+    Node son;
+    son.transition = nodes[g.node].contacts;
+    son.transition.push_back(cand.added);
+    son.contacts = son.transition;
+    son.contacts.back().supporting = true;
+    son.q = res.configuration;
+    son.parent = g.node;
+    son.change = Change::Added;
+    son.generator = gi;
+    son.key = keyOf(res.configuration);  // also orders the parts of its volume
+    if (p.optimized_candidates)
+      for (auto& part : subtractBox(cand.volume, res.floating, p.box)) gens[gi].volumes.push_back({son.key, part});
+    return addNode(son, true);
+  }
+
   // The next son of a pair generator, or -1 when it has none left.
   int nextSon(int gi) {
-    while (budgetLeft() && goal_node < 0) {
-      PairGenerator& g = gens[gi];
-      const Node& n = nodes[g.node];
-      PostureRequest r;
-      r.contacts = n.contacts;
-      r.initial_guess = n.q;
-      r.cost = costFrom(n.q);
-      ContactSpec added;
-      added.spot = g.spot;
-      added.surface = g.surface;
-      added.supporting = false;
-      SearchVolume volume;
-      if (p.optimized_candidates) {
-        if (g.volumes.empty()) return -1;
-        // the volume whose parent candidate was best, first
-        std::size_t best = 0;
-        for (std::size_t k = 1; k < g.volumes.size(); ++k)
-          if (g.volumes[k].first < g.volumes[best].first) best = k;
-        volume = g.volumes[best].second;
-        g.volumes.erase(g.volumes.begin() + best);
-        FloatingContact f;
-        f.spot = g.spot;
-        f.surface = g.surface;
-        f.volume = volume;
-        r.floating = f;
-      } else {
-        if (g.samples_left-- <= 0) return -1;
-        // the paper's earlier method: a random placement on the surface
-        const Surface& s = sc.scene->surfaces()[g.surface];
-        Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
-        for (const auto& v : s.polygon.vertices()) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-        std::uniform_real_distribution<double> u(0, 1);
-        do {
-          added.placement.x = lo.x() + (hi.x() - lo.x()) * u(rng);
-          added.placement.y = lo.y() + (hi.y() - lo.y()) * u(rng);
-        } while (!s.polygon.contains({added.placement.x, added.placement.y}));
-        added.placement.theta = -M_PI + 2 * M_PI * u(rng);
-        r.contacts.push_back(added);
-      }
-      const PostureResult res = solve(r);
-      if (p.trace)
-        p.trace("  add " + sc.robot->spots()[g.spot].name + "@" + sc.scene->surfaces()[g.surface].name + ": " +
-                toString(res.status) + " (" + std::to_string(res.iterations) + " it, " +
-                std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
-      if (!res.success()) continue;  // that volume (or sample) holds no feasible contact
-      if (p.optimized_candidates) added.placement = res.floating;
-      Node son;
-      son.transition = nodes[g.node].contacts;
-      son.transition.push_back(added);
-      son.contacts = son.transition;
-      son.contacts.back().supporting = true;
-      son.q = res.configuration;
-      son.parent = g.node;
-      son.change = Change::Added;
-      son.generator = gi;
-      son.key = keyOf(res.configuration);  // also orders the parts of its volume
-      if (p.optimized_candidates)
-        for (auto& part : subtractBox(volume, res.floating, p.box)) gens[gi].volumes.push_back({son.key, part});
-      const int id = addNode(son, true);
+    Candidate cand;
+    while (budgetLeft() && goal_node < 0 && nextCandidate(gi, cand)) {
+      const int id = acceptCandidate(gi, cand, solveAll({cand.request})[0]);
       if (id >= 0) return id;
     }
     return -1;
-  }
-
-  int depth(int ni) const {
-    int d = 0;
-    for (; nodes[ni].parent >= 0; ni = nodes[ni].parent) ++d;
-    return d;
-  }
-
-  void traceExpansion(int ni) {
-    if (!p.trace) return;
-    const Node& n = nodes[ni];
-    kin.setConfiguration(n.q);
-    const Eigen::Vector3d w = kin.linkPose(sc.goal.link).translation();
-    std::string line = "expand #" + std::to_string(ni) + " depth " + std::to_string(depth(ni)) + " key " +
-                       std::to_string(n.key) + " goal link (" + std::to_string(w.x()).substr(0, 6) + ", " +
-                       std::to_string(w.y()).substr(0, 6) + ", " + std::to_string(w.z()).substr(0, 6) + "):";
-    for (const auto& c : n.contacts) line += " " + sc.robot->spots()[c.spot].name + "@" +
-                                             sc.scene->surfaces()[c.surface].name;
-    line += "  [" + std::to_string(stats.nodes_generated) + " nodes, " + std::to_string(stats.posture_calls) +
-            " calls, " + std::to_string(elapsed()).substr(0, 6) + " s]";
-    p.trace(line);
   }
 
   void expand(int ni) {
@@ -346,13 +397,13 @@ struct ContactPlanner::Impl {
     traceExpansion(ni);
     removalSons(ni);
     if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return;
+    std::vector<int> pairs;
     for (int spot : sc.allowed_spots) {
       bool used = false;
       for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
       if (used) continue;
       for (int surface : sc.allowed_surfaces) {
-        if (!budgetLeft() || goal_node >= 0) return;
-        kin.setConfiguration(nodes[ni].q);  // nextSon below moves it
+        kin.setConfiguration(nodes[ni].q);
         if (!reachable(spot, surface, kin)) continue;
         PairGenerator g;
         g.node = ni;
@@ -361,11 +412,32 @@ struct ContactPlanner::Impl {
         g.volumes.push_back({0.0, fullVolume(sc.scene->surfaces()[surface].polygon)});
         g.samples_left = p.random_samples_per_pair;
         gens.push_back(g);
-        const int gi = static_cast<int>(gens.size()) - 1;
-        const int sons = p.lazy_sons ? 1 : (p.optimized_candidates ? p.eager_candidates_per_pair : p.random_samples_per_pair);
-        for (int k = 0; k < sons; ++k)
-          if (nextSon(gi) < 0) break;
+        pairs.push_back(static_cast<int>(gens.size()) - 1);
       }
+    }
+    if (!p.lazy_sons) {
+      const int sons = p.optimized_candidates ? p.eager_candidates_per_pair : p.random_samples_per_pair;
+      for (int gi : pairs)
+        for (int k = 0; k < sons && budgetLeft() && goal_node < 0; ++k)
+          if (nextSon(gi) < 0) break;
+      return;
+    }
+    // Lazy sons: each pair's first son. The first candidates are independent
+    // of each other: solved as one batch; a pair whose first candidate makes
+    // no son goes on sequentially (its remaining volumes).
+    if (!budgetLeft() || goal_node >= 0) return;
+    std::vector<Candidate> cands(pairs.size());
+    std::vector<PostureRequest> requests;
+    std::vector<int> with_candidate;
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      if (nextCandidate(pairs[k], cands[k])) {
+        requests.push_back(cands[k].request);
+        with_candidate.push_back(static_cast<int>(k));
+      }
+    const std::vector<PostureResult> results = solveAll(requests);
+    for (std::size_t j = 0; j < with_candidate.size() && goal_node < 0; ++j) {
+      const int k = with_candidate[j];
+      if (acceptCandidate(pairs[k], cands[k], results[j]) < 0 && results[j].success()) nextSon(pairs[k]);
     }
   }
 
@@ -409,10 +481,10 @@ struct ContactPlanner::Impl {
           r.contacts = prev.contacts;
           r.initial_guess = cur.q;
           r.cost = costFrom(cur.q);
-          PostureResult res = solve(r);
+          PostureResult res = solveAll({r})[0];
           if (!res.success()) {
             r.initial_guess = prev.q;
-            res = solve(r);
+            res = solveAll({r})[0];
           }
           push(prev.contacts, res.success() ? res.configuration : prev.q);
         }

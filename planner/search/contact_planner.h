@@ -45,6 +45,10 @@ struct PlannerParameters {
   int eager_candidates_per_pair = 6;   // with lazy_sons = false: candidates per pair at expansion
   bool guide_potential = true;         // paper 2.7 (false: distance to the goal)
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
+  // Posture generators run at once on independent sons (removal sons, each
+  // pair's first son). Results do not depend on it: request i of a batch
+  // always goes to generator i % threads.
+  int threads = 2;
   // Called with one line per expanded node (for -v); empty: silent.
   std::function<void(const std::string&)> trace;
   PlannerParameters();

@@ -6,7 +6,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   PlannerParameters p;
   if (!sc.planner_section) return p;
   const YamlField& f = *sc.planner_section;
-  f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "box_half_sizes", "duplicate_distance", "duplicate_angle",
+  f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations",
                "collision_margin"});
   auto positive = [&](const char* key, double& out) {
@@ -37,6 +37,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   count("max_nodes", p.max_nodes);
   count("max_posture_calls", p.max_posture_calls);
   count("posture_iterations", p.posture.max_iterations);
+  count("threads", p.threads);
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
     if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
