@@ -631,6 +631,10 @@ TEST(Hrp2Export, SequencePlayerFilesParseBackWithColumnsRateAndContinuity) {
   }
   EXPECT_EQ(p.zmp_lp_failures, 0);
   EXPECT_EQ(p.zmp_from_forces, static_cast<int>(p.samples.size()));
+  // Same input, same files, byte for byte.
+  writeSequencePlayer(prepared(tr), dir.path() + "/again");
+  for (const char* ext : {".pos", ".waist", ".zmp"})
+    EXPECT_EQ(test::readFile(dir.path() + "/motion" + ext), test::readFile(dir.path() + "/again" + ext)) << ext;
 }
 
 // ---------------------------------------------------------------- simulator

@@ -225,15 +225,40 @@ double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
 }  // namespace
 
 TEST_F(Hrp2Processes, TrajectoryPlayedEndToEndWithTrackingErrorReported) {
-  const Trajectory tr = armMotion(1.5, -0.5);
+  // Two phases: seated (feet and thighs: the stabilizer off), then the thighs
+  // released at 0.75 s (feet only: on again 0.1 s later, the default lag).
+  Trajectory tr = armMotion(1.5, -0.5);
+  TrajectoryPhase feet = tr.phases[0];
+  feet.contacts.resize(2);
+  ASSERT_EQ(chair().robot->spots()[feet.contacts[1].spot].name, "l_sole");
+  tr.phases[0].t_end = feet.t_start = 0.75;
+  tr.phases.push_back(feet);
+  for (auto& s : tr.samples) s.phase = s.t < 0.75 - 1e-9 ? 0 : 1;
   const std::string file = trajectoryFile(tr, "arm.json");
   Child& s = sim();
   Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig()});
   EXPECT_EQ(wait(b, 20), 0) << logs();
   serveFor(0.2);
   std::size_t streamed = 0;
-  for (const auto& c : heard_.commands) streamed += c.mode == hrp2_command_t::STREAM;
+  for (const auto& c : heard_.commands) {
+    if (c.mode != hrp2_command_t::STREAM) continue;
+    // The stabilizer flag and the references travel with every command.
+    const double t = kDt * streamed++;
+    EXPECT_EQ(bool(c.stabilizer), t >= 0.85 - 1e-9) << "t = " << t;
+    EXPECT_NEAR(c.waist_position[2], chair().start.base_position.z(), 1e-9);
+    EXPECT_NEAR(c.zmp_waist[2], -chair().start.base_position.z(), 1e-6) << "the ZMP is on the floor, in the waist frame";
+  }
   EXPECT_EQ(streamed, tr.samples.size());
+  // The simulator's contact wrenches carry the weight (at the start: feet and thighs).
+  // (the LP runs on its own thread: the first states may come before its first result)
+  std::size_t k = 0;
+  while (k + 1 < heard_.states.size() && heard_.states[k].num_wrenches == 0) ++k;
+  EXPECT_LT(k, 40u) << "no wrenches in the first 0.2 s";
+  const hrp2_state_t& first = heard_.states[k];
+  EXPECT_EQ(first.num_wrenches, 4);
+  double fz = 0;
+  for (int i = 0; i < first.num_wrenches; ++i) fz += first.wrenches[i][2];  // spot z is the normal: level spots
+  EXPECT_NEAR(fz, chair().robot->totalMass() * 9.81, 1.0);
   ASSERT_FALSE(heard_.statuses.empty());
   const hrp2_bridge_status_t& last = heard_.statuses.back();
   EXPECT_EQ(last.state, +hrp2_bridge_status_t::IDLE) << last.reason;
