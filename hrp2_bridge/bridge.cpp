@@ -148,7 +148,7 @@ bool Bridge::beginCheck(std::int64_t request_id, std::int64_t now, std::string* 
     if (state_ == BridgeState::Fault) w += " (reset: e-stop engage then release)";
     if (state_ == BridgeState::Stopped) w += " (e-stop engaged)";
     if (why) *why = w;
-    events_.push_back({now, state_, w, false});  // the state's own reason stays
+    events_.push_back({now, state_, w, false, request_id, false, true});  // the state's own reason stays
     return false;
   }
   before_check_ = state_;
@@ -165,6 +165,8 @@ void Bridge::endCheck(std::int64_t request_id, PrepareResult result, std::int64_
   checking_id_ = -1;
   auto refuse = [&](const std::string& why) {
     enter(before_check_, now, "refused request " + std::to_string(request_id) + ": " + why, true);
+    events_.back().request_id = request_id;
+    events_.back().refused = true;
   };
   if (!result.check.ok) return refuse(result.check.reason);
   if (result.prepared.samples.empty()) return refuse("nothing to stream");
@@ -202,6 +204,8 @@ void Bridge::endCheck(std::int64_t request_id, PrepareResult result, std::int64_
 
 void Bridge::refuse(std::int64_t request_id, const std::string& why, std::int64_t now) {
   event(now, "refused request " + std::to_string(request_id) + ": " + why, true);
+  events_.back().request_id = request_id;
+  events_.back().refused = true;
 }
 
 Command& Bridge::remember(Command c) {
@@ -267,6 +271,8 @@ Command Bridge::streamCommand(std::int64_t now) {
           "done: request " + std::to_string(request_id_) +
               fmt(" played (%.3f s), worst tracking error %.4f rad", d, tracking_error_max_),
           false);
+    events_.back().request_id = request_id_;
+    events_.back().done = true;
   }
   return sent;
 }

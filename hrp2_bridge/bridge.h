@@ -70,6 +70,9 @@ struct BridgeEvent {
   BridgeState state = BridgeState::Idle;
   std::string text;
   bool safety = false;
+  std::int64_t request_id = -1;  // the trajectory it is about, when done or refused
+  bool done = false;             // played to the end
+  bool refused = false;          // refused (busy, a check, the start guard, bad input)
 };
 
 class Bridge {

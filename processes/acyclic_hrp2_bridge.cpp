@@ -313,8 +313,10 @@ int main(int argc, char** argv) {
     for (const hrp2::BridgeEvent& e : events) {
       if (e.safety) status.error(st.request_id, e.text);
       else proc::log(kName, e.text);
-      if (file_mode && e.text.rfind("done: request " + std::to_string(file_request_id) + " ", 0) == 0) file_done = true;
-      if (file_mode && e.text.rfind("refused request " + std::to_string(file_request_id) + ":", 0) == 0) file_failed = true;
+      if (file_mode && e.request_id == file_request_id) {
+        file_done |= e.done;
+        file_failed |= e.refused;
+      }
     }
     if (st.state != last_state || now - last_status >= cfg.status_period * 1e6) {
       bus->publish(channels::kHrp2BridgeStatus, toMessage(st));

@@ -338,6 +338,10 @@ TEST(Hrp2Bridge, StreamsEveryPreparedSampleOncePerPeriodThenIdles) {
   EXPECT_DOUBLE_EQ(st.progress, 1.0);
   EXPECT_EQ(st.safety_events, 0);
   EXPECT_NE(st.reason.find("done"), std::string::npos) << st.reason;
+  const auto events = rig.bridge.takeEvents();
+  ASSERT_FALSE(events.empty());
+  EXPECT_TRUE(events.back().done);
+  EXPECT_EQ(events.back().request_id, 7);
 }
 
 TEST(Hrp2Bridge, StaleStateHoldsWithinThreePeriods) {
@@ -446,6 +450,23 @@ TEST(Hrp2Bridge, EstopFreezesAndReleaseBlendsBackToTheEnd) {
   EXPECT_EQ(rig.bridge.status(rig.now).safety_events, 2);  // engage, release
 }
 
+TEST(Hrp2Bridge, EstopWhileIdleFreezesWhereTheRobotStands) {
+  Rig rig;
+  rig.robot.q[20] += 0.01;  // not the start posture: the measured one counts
+  rig.period();
+  rig.bridge.onEstop(true, "", rig.now);
+  rig.periods(3);
+  ASSERT_EQ(rig.sent.size(), 3u);
+  for (const Command& c : rig.sent) {
+    EXPECT_EQ(c.mode, CommandMode::Freeze);
+    EXPECT_EQ(c.q, rig.robot.q);
+  }
+  rig.bridge.onEstop(false, "", rig.now);
+  rig.periods(3);
+  EXPECT_EQ(rig.bridge.state(), BridgeState::Idle);
+  EXPECT_EQ(rig.sent.size(), 3u) << "idle again: nothing commanded";
+}
+
 TEST(Hrp2Bridge, NanOrLimitViolationIsRefusedAndNothingMoves) {
   Rig rig;
   Trajectory bad = synthetic(0.5);
@@ -460,6 +481,10 @@ TEST(Hrp2Bridge, NanOrLimitViolationIsRefusedAndNothingMoves) {
   EXPECT_EQ(st.safety_events, 2);
   EXPECT_NE(st.reason.find("refused request 12"), std::string::npos) << st.reason;
   EXPECT_NE(st.reason.find("HEAD_JOINT0"), std::string::npos) << st.reason;
+  const auto events = rig.bridge.takeEvents();
+  ASSERT_FALSE(events.empty());
+  EXPECT_TRUE(events.back().refused);
+  EXPECT_EQ(events.back().request_id, 12);
   // A good one afterwards goes.
   EXPECT_TRUE(rig.load(synthetic(0.5), 13));
 }
