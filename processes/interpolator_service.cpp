@@ -103,7 +103,8 @@ class InterpolatorService {
         out.reason = r.reason;
         proc::log(kProcess, "request " + std::to_string(id) + ": " + toString(r.status) +
                                 (r.success() ? ", " + std::to_string(out.num_samples) + " samples" : ": " + r.reason));
-        if (!r.success()) status_.error(id, std::string(toString(r.status)) + ": " + r.reason);
+        if (!r.success() && r.status != InterpolationResult::Status::Cancelled)
+          status_.error(id, std::string(toString(r.status)) + ": " + r.reason);
       } catch (const std::exception& e) {
         out = trajectory_t{};
         out.status = trajectory_t::ERROR;

@@ -137,7 +137,9 @@ class PlannerService {
         proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + toString(r.status) + " in " +
                                 std::to_string(r.stats.seconds) + " s, " + std::to_string(r.stats.nodes_generated) +
                                 " nodes" + (r.solved() ? ", " + std::to_string(m.num_stances) + " stances" : ""));
-        if (!r.solved()) status_.error(req.request_id, std::string(toString(r.status)) + ": " + r.reason);
+        // A cancellation was asked for: not an error.
+        if (!r.solved() && r.status != PlanningResult::Status::Cancelled)
+          status_.error(req.request_id, std::string(toString(r.status)) + ": " + r.reason);
       } catch (const std::exception& e) {
         m = plan_t{};
         m.status = plan_t::ERROR;

@@ -4,6 +4,8 @@
 // and checks what they answer and the files and logs they write.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -231,4 +233,54 @@ TEST(Pipeline, APlannerKilledMidRequestIsRestartedAndTheLauncherResendsItsWork) 
   // The restarted planner answered the re-sent request (not solved in 3 s).
   EXPECT_NE(run.output.find("plan: status"), std::string::npos) << run.output;
   EXPECT_EQ(run.status, 1) << run.output;
+}
+
+namespace {
+
+// Starts a process (no shell); returns its pid.
+pid_t spawn(const std::vector<std::string>& argv) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits for a pid; its exit status, or -1 if it is still running after `seconds`.
+int waitExit(pid_t pid, double seconds) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(seconds)) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  return -1;
+}
+
+}  // namespace
+
+TEST(Pipeline, ProcessesExitCleanlyOnSigintAndSigtermEvenMidRequest) {
+  REQUIRE_NETNS();
+  std::vector<std::string> names = {"acyclic-planner"};
+  if (haveInterpolator()) names.push_back("acyclic-interpolator");
+  for (const auto& name : names)
+    for (const int sig : {SIGINT, SIGTERM}) {
+      Client c;
+      const pid_t pid = spawn({exe(name), "--lcm"});
+      ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(name, process_status_t::IDLE); }, 20)) << name;
+      if (name == "acyclic-planner") {
+        // Busy on the chair (not solved): the signal must cancel it, not wait for it.
+        c.bus.publish(channels::kRequest, c.request(3, "models/scenarios/chair_table.yaml", 60));
+        ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(name, process_status_t::BUSY, 3); }, 20));
+      }
+      kill(pid, sig);
+      EXPECT_EQ(waitExit(pid, 5), 0) << name << " after signal " << sig;
+      EXPECT_TRUE(c.waitFor([&] { return c.sawStatus(name, process_status_t::STOPPING); }, 2)) << name;
+    }
 }
