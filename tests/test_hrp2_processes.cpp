@@ -408,6 +408,17 @@ TEST_F(Hrp2Processes, SecondTrajectoryWhileStreamingIsRefusedNotQueued) {
   EXPECT_EQ(stop(s), 0);
 }
 
+TEST_F(Hrp2Processes, StartGuardRefusesAServoOffRobotAndNothingMoves) {
+  const std::string file = trajectoryFile(armMotion(1.0, -0.4), "arm.json");
+  Child& s = sim({"--servo-off"});
+  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file});
+  EXPECT_EQ(wait(b, 10), 1) << logs();
+  EXPECT_NE(test::readFile(b.log).find("start guard: servo off"), std::string::npos) << logs();
+  serveFor(0.1);
+  EXPECT_TRUE(heard_.commands.empty());
+  EXPECT_EQ(stop(s), 0);
+}
+
 TEST_F(Hrp2Processes, HelpAndBadInput) {
   for (const char* exe : {"acyclic-hrp2-bridge", "acyclic-hrp2-sim", "acyclic-hrp2-export"}) {
     const auto r = test::runProcess(test::binaryPath(std::string("processes/") + exe) + " --help");
