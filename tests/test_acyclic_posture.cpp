@@ -1,0 +1,44 @@
+// acyclic-posture, the scenario author's probe: one posture-generator call on
+// a start stance, chained through --out/--from; its witnesses pass the
+// independent check (the exit status says so) and it names bad input.
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+
+namespace {
+acyclic::test::ProcessRun probe(const std::string& args) {
+  return acyclic::test::runProcess(acyclic::test::binaryPath("processes/acyclic-posture") + " " +
+                                   acyclic::test::sourcePath("models/scenarios/chair_table.yaml") + " " + args);
+}
+}  // namespace
+
+TEST(AcyclicPosture, AWristOnTheTableAddedThenReleasedChainThroughFiles) {
+  acyclic::test::TempDir dir;
+  const auto a = probe("--add l_wrist@table_top --out " + dir.path() + "/a.json");
+  ASSERT_EQ(a.status, 0) << a.output;
+  EXPECT_NE(a.output.find("success"), std::string::npos);
+  EXPECT_NE(a.output.find("added l_wrist@table_top"), std::string::npos);
+  EXPECT_NE(a.output.find("[ ok ] equilibrium"), std::string::npos) << a.output;
+  // From that stance (the wrist now supporting, part of the stance), release it again.
+  const auto b = probe("--from " + dir.path() + "/a.json --remove l_wrist");
+  EXPECT_EQ(b.status, 0) << b.output;
+  // From the start, one thigh released: the other and the feet carry the robot.
+  const auto c = probe("--remove r_thigh");
+  EXPECT_EQ(c.status, 0) << c.output;
+}
+
+TEST(AcyclicPosture, BothThighsOffWithFeetAloneIsNotFoundAndExitsOne) {
+  // Seated with the feet 0.3 m ahead of the hips: the centre of mass cannot
+  // come over the feet while both thighs still touch the seat.
+  const auto r = probe("--remove r_thigh --remove l_thigh --iterations 100");
+  EXPECT_EQ(r.status, 1) << r.output;
+}
+
+TEST(AcyclicPosture, BadInputIsNamedAndExitsTwo) {
+  auto r = probe("--remove r_hand");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("r_hand"), std::string::npos) << r.output;
+  r = probe("--add l_wrist@ceiling");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("ceiling"), std::string::npos) << r.output;
+}
