@@ -76,6 +76,10 @@ int main(int argc, char** argv) {
   app.add_option("--cpu", cpu, "pin the loop to this CPU, and the load to the others (default: no pinning)");
   CLI11_PARSE(app, argc, argv);
 
+  if (cpu >= sysconf(_SC_NPROCESSORS_ONLN)) {
+    std::fprintf(stderr, "bench_bridge_jitter: --cpu %d: this machine has %ld CPUs\n", cpu, sysconf(_SC_NPROCESSORS_ONLN));
+    return 2;
+  }
   const Scenario sc = Scenario::load(std::string(ACYCLIC_SOURCE_DIR) + "/models/scenarios/chair_table.yaml");
   hrp2::BridgeConfig cfg;
   cfg.dt = dt;
@@ -104,14 +108,19 @@ int main(int argc, char** argv) {
     posix_spawnattr_destroy(&attr);
   }
   if (cpu >= 0) {
-    cpu_set_t loop_set, others;
-    CPU_ZERO(&loop_set);
+    cpu_set_t others;
     CPU_ZERO(&others);
-    CPU_SET(cpu, &loop_set);
     for (int c = 0; c < CPU_SETSIZE && c < 64; ++c)
       if (c != cpu) CPU_SET(c, &others);
     if (planner > 0) sched_setaffinity(planner, sizeof others, &others);
-    sched_setaffinity(0, sizeof loop_set, &loop_set);  // the calling (loop) thread
+    std::string why;
+    if (!hrp2::pinToCpu(cpu, &why)) {  // as acyclic-hrp2-bridge --cpu
+      std::fprintf(stderr, "bench_bridge_jitter: --cpu %d: %s\n", cpu, why.c_str());
+      stop = true;
+      if (busy.joinable()) busy.join();
+      if (planner > 0) kill(-planner, SIGKILL), waitpid(planner, nullptr, 0);
+      return 2;
+    }
   }
   if (busy.joinable() && cpu >= 0) {
     cpu_set_t others;

@@ -30,6 +30,19 @@ bool setRealtimePriority(int priority, std::string* why) {
   return e == 0;
 }
 
+bool pinToCpu(int cpu, std::string* why) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (cpu < 0 || cpu >= CPU_SETSIZE) {
+    if (why) *why = "no CPU " + std::to_string(cpu);
+    return false;
+  }
+  CPU_SET(cpu, &set);
+  const int e = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+  if (e != 0 && why) *why = std::strerror(e);
+  return e == 0;
+}
+
 bool lockMemory(std::string* why) {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) return true;
   if (why) *why = std::strerror(errno);

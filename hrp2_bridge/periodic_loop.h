@@ -17,6 +17,10 @@ std::int64_t monotonicMicros();
 // sleeps almost all the time and must wake on time on a busy machine. Threads
 // created afterwards inherit it. False (with the reason) when not permitted.
 bool setRealtimePriority(int priority, std::string* why = nullptr);
+// The calling thread (and the threads it creates afterwards) to one CPU.
+// False (with the reason) when the CPU does not exist or is not allowed.
+bool pinToCpu(int cpu, std::string* why = nullptr);
+
 // Locks the process's memory (mlockall, current and future): a page fault
 // in a real-time loop costs milliseconds. False (with the reason) when not permitted.
 bool lockMemory(std::string* why = nullptr);

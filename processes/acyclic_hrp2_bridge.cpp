@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
       "file's trajectory refused or not played to the end; 2 bad input; 3 LCM failure."};
   std::string scenario_path, trajectory_path, config_path, url = proc::defaultLcmUrl();
   double dt = 0, wait_state = 5.0;
-  int zmp_stride = 10, rt_priority = 20;
+  int zmp_stride = 10, rt_priority = 20, cpu = -1;
   std::int64_t file_request_id = 1;
   app.add_option("--scenario", scenario_path,
                  "scenario (robot and scene); required in LCM mode, default in file mode: the trajectory's own");
@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
                  "SCHED_FIFO priority of the control loop and LCM receive threads, 0: none (default 20; when not\n"
                  "permitted the bridge says so and runs at normal priority)")
       ->check(CLI::Range(0, 99));
+  app.add_option("--cpu", cpu, "run on this CPU only (default: any); e.g. the one the planner does not use");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   CLI11_PARSE(app, argc, argv);
 
@@ -142,6 +143,13 @@ int main(int argc, char** argv) {
   // Real time before LCM starts its threads, so that they inherit it; the
   // heavy threads (checks, trajectory intake) drop it.
   std::string rt_note = "normal priority";
+  if (cpu >= 0) {
+    std::string why;
+    if (!hrp2::pinToCpu(cpu, &why)) {
+      std::fprintf(stderr, "%s: --cpu %d: %s\n", kName, cpu, why.c_str());
+      return 2;
+    }
+  }
   if (rt_priority > 0) {
     std::string why;
     if (hrp2::setRealtimePriority(rt_priority, &why)) {
@@ -279,7 +287,7 @@ int main(int argc, char** argv) {
   });
 
   proc::log(kName, "controller period " + std::to_string(cfg.dt) + " s; robot " + sc.robot->name() + ", " +
-                       std::to_string(n) + " joints; " + rt_note + (file_mode ? "; file mode: " + trajectory_path : ""));
+                       std::to_string(n) + " joints; " + rt_note + (cpu >= 0 ? ", CPU " + std::to_string(cpu) : "") + (file_mode ? "; file mode: " + trajectory_path : ""));
   status.idle();
   hrp2::PeriodicLoop loop(cfg.dt);
   const std::int64_t t0 = hrp2::monotonicMicros();
