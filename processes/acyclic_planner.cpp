@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "planner/common/format_error.h"
+#include "planner/plan/guide.h"
 #include "planner/search/planner_parameters.h"
 #include "processes/lcm_process.h"
 #include "processes/planner_service.h"
@@ -24,12 +25,15 @@ int main(int argc, char** argv) {
       "ACYCLIC_PROGRESS during the search, ACYCLIC_STATUS at 1 Hz and on every error, and ACYCLIC_CANCEL.\n"
       "One request at a time: a request that arrives while one runs is refused (ACYCLIC_PLAN with\n"
       "status ERROR and the reason, and a status error). Exits 0 on SIGINT/SIGTERM."};
-  std::string in, out, url = acyclic::proc::defaultLcmUrl();
+  std::string in, out, guide_path, url = acyclic::proc::defaultLcmUrl();
   bool lcm_mode = false;
   acyclic::PlannerOverrides o;
   bool quiet = false;
   app.add_option("--in", in, "scenario file (acyclic.scenario/1), file mode");
   app.add_option("--out", out, "plan file to write (acyclic.plan/1), file mode");
+  app.add_option("--guide", guide_path,
+                 "key postures from this guide file (acyclic.guide/1, e.g. from acyclic-guide) instead of the "
+                 "scenario's, file mode");
   app.add_flag("--lcm", lcm_mode, "serve requests on LCM instead of the file mode");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--seed", o.seed, "overrides the scenario's (and the request's) seed");
@@ -61,6 +65,12 @@ int main(int argc, char** argv) {
   }
   try {
     acyclic::Scenario sc = acyclic::Scenario::load(in);
+    if (!guide_path.empty()) sc.key_postures = acyclic::readGuide(guide_path, sc).key_postures;
+    if (sc.key_postures.size() < 2 && !o.distance_to_goal) {
+      std::fprintf(stderr, "acyclic-planner: %s: no key postures (at least two): give --guide GUIDE "
+                   "(acyclic-guide writes one) or write them in the scenario\n", in.c_str());
+      return 2;
+    }
     const acyclic::PlannerParameters p = o.apply(sc, -1);
     acyclic::ContactPlanner planner(sc, p);
     const bool tty = !quiet && isatty(STDERR_FILENO);

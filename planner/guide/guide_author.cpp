@@ -1,0 +1,276 @@
+#include "planner/guide/guide_author.h"
+
+#include <chrono>
+#include <cmath>
+
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+
+#include "planner/check/validity.h"
+#include "planner/collision/collision_model.h"
+#include "planner/common/geometry.h"
+#include "planner/posture/posture_generator.h"
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace acyclic {
+
+const char* toString(GuideResult::Status s) {
+  switch (s) {
+    case GuideResult::Status::Success: return "success";
+    case GuideResult::Status::InvalidStart: return "invalid start";
+    case GuideResult::Status::NoGoalPosture: return "no goal posture";
+    case GuideResult::Status::NoPath: return "no path";
+    case GuideResult::Status::Cancelled: return "cancelled";
+  }
+  return "?";
+}
+
+namespace {
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double yawOf(const Eigen::Quaterniond& q) {
+  const Eigen::Matrix3d R = q.toRotationMatrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
+// The reduced space: (x, y, z, yaw, alpha). alpha blends the joints and the
+// base's tilt from the start posture (0) to the goal posture (1).
+struct Lift {
+  Configuration start, goal;
+  double yaw_start = 0, yaw_goal = 0;
+  Configuration operator()(const double* s) const {
+    const double a = std::clamp(s[4], 0.0, 1.0);
+    Configuration q;
+    q.base_position = Eigen::Vector3d(s[0], s[1], s[2]);
+    const Eigen::Quaterniond tilt = start.base_orientation.slerp(a, goal.base_orientation);
+    const double yaw_blend = (1 - a) * yaw_start + a * yaw_goal;
+    q.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(s[3] - yaw_blend, Eigen::Vector3d::UnitZ())) * tilt;
+    q.base_orientation.normalize();
+    q.joints = (1 - a) * start.joints + a * goal.joints;
+    return q;
+  }
+};
+
+// Valid: every robot-environment pair at least -penetration apart. Self
+// pairs are left out: the joints blend between two valid postures.
+class RelaxedValidity : public ob::StateValidityChecker {
+ public:
+  RelaxedValidity(const ob::SpaceInformationPtr& si, const Scenario& sc, const Lift& lift, double penetration)
+      : ob::StateValidityChecker(si), lift_(lift), kin_(sc.robot), collision_(sc.robot, sc.scene),
+        penetration_(penetration) {}
+  bool isValid(const ob::State* state) const override {
+    const double* s = state->as<ob::RealVectorStateSpace::StateType>()->values;
+    kin_.setConfiguration(lift_(s));
+    DistanceOptions o;
+    o.cutoff = 0.0;  // only pairs whose bounding volumes may touch
+    for (const auto& d : collision_.distances(kin_, o))
+      if (collision_.pairs()[d.pair].kind == CollisionPair::Kind::RobotEnvironment && d.distance < -penetration_)
+        return false;
+    return true;
+  }
+
+ private:
+  const Lift& lift_;
+  mutable Kinematics kin_;
+  CollisionModel collision_;
+  double penetration_;
+};
+
+// OMPL's random generators, seeded per call: the same scenario and seed give
+// the same guide in any process, however many guides it made before.
+class SeededSampler : public ob::RealVectorStateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, unsigned seed) : ob::RealVectorStateSampler(space) {
+    rng_.setLocalSeed(seed);
+  }
+};
+class SeededRRTConnect : public og::RRTConnect {
+ public:
+  SeededRRTConnect(const ob::SpaceInformationPtr& si, unsigned seed) : og::RRTConnect(si) { rng_.setLocalSeed(seed); }
+};
+class SeededSimplifier : public og::PathSimplifier {
+ public:
+  SeededSimplifier(const ob::SpaceInformationPtr& si, unsigned seed) : og::PathSimplifier(si) {
+    rng_.setLocalSeed(seed);
+  }
+};
+
+// A standing posture in the goal region: the named standing posture moved
+// there, feet put on the start's floor surface, then the posture generator
+// and the independent check. Tries the free horizontal coordinate around the
+// start's, nearest first.
+bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, std::string& why) {
+  const RobotModel& m = *sc.robot;
+  if (!m.postures().count(o.standing_posture)) {
+    why = "the robot has no posture named '" + o.standing_posture + "'";
+    return false;
+  }
+  const int r_sole = m.spotIndex("r_sole"), l_sole = m.spotIndex("l_sole");
+  int floor = -1;
+  for (const auto& c : sc.start_stance)
+    if (c.spot == r_sole || c.spot == l_sole) floor = c.surface;
+  if (r_sole < 0 || l_sole < 0 || floor < 0) {
+    why = "the start stance has no sole on a surface to stand on";
+    return false;
+  }
+  const GoalCondition& g = sc.goal;
+  if (g.axis == 2) {
+    why = "a goal on the vertical axis is not supported by the guide author";
+    return false;
+  }
+  Configuration standing = m.posture(o.standing_posture);
+  const double yaw = yawOf(sc.start.base_orientation);
+  standing.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  Kinematics kin(sc.robot);
+  // Where the goal link sits relative to the base when standing.
+  kin.setConfiguration(standing);
+  const Eigen::Vector3d link_offset = kin.linkPose(g.link).translation() - standing.base_position;
+  const double bound = std::isfinite(g.min) ? g.min + o.goal_margin : g.max - o.goal_margin;
+  PostureGeneratorOptions po;
+  po.max_iterations = 200;
+  po.max_seconds = 2.0;
+  PostureGenerator pg(sc.robot, sc.scene, po);
+  ValidityChecker checker(sc.robot, sc.scene);
+  const int free_axis = g.axis == 0 ? 1 : 0;
+  std::vector<double> offsets = {0.0};
+  for (double d = 0.1; d <= o.goal_search + 1e-9; d += 0.1) offsets.push_back(d), offsets.push_back(-d);
+  for (double off : offsets) {
+    Configuration q = standing;
+    q.base_position[g.axis] = bound - link_offset[g.axis];
+    q.base_position[free_axis] = sc.start.base_position[free_axis] + off;
+    kin.setConfiguration(q);
+    PostureRequest r;
+    for (int spot : {r_sole, l_sole}) {
+      ContactSpec c;
+      c.spot = spot;
+      c.surface = floor;
+      c.supporting = true;
+      c.placement = projectOnSurface(sc.scene->surfaces()[floor], kin.linkPose(m.spots()[spot].link) * m.spots()[spot].frame);
+      r.contacts.push_back(c);
+    }
+    r.initial_guess = q;
+    const PostureResult res = pg.solve(r);
+    if (!res.success()) continue;
+    if (!checker.checkPosture(res.configuration, r.contacts).valid()) continue;
+    kin.setConfiguration(res.configuration);
+    if (!g.satisfied(kin)) continue;
+    out = res.configuration;
+    return true;
+  }
+  why = "no valid standing posture found in the goal region (" + g.describe(m) + ") within " +
+        std::to_string(o.goal_search) + " m of the start";
+  return false;
+}
+
+}  // namespace
+
+GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::atomic<bool>* cancel) {
+  GuideResult out;
+  const double t0 = now();
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  Configuration goal;
+  if (!goalPosture(sc, o, goal, out.reason)) {
+    out.status = GuideResult::Status::NoGoalPosture;
+    return out;
+  }
+  out.goal_seconds = now() - t0;
+
+  Lift lift{sc.start, goal, yawOf(sc.start.base_orientation), yawOf(goal.base_orientation)};
+  auto space = std::make_shared<ob::RealVectorStateSpace>(5);
+  ob::RealVectorBounds b(5);
+  for (int k = 0; k < 3; ++k) {
+    const double lo = std::min(sc.start.base_position[k], goal.base_position[k]);
+    const double hi = std::max(sc.start.base_position[k], goal.base_position[k]);
+    const double margin = k == 2 ? 0.15 : 0.6;  // sideways room for detours; a little height
+    b.setLow(k, lo - margin);
+    b.setHigh(k, hi + margin);
+  }
+  b.setLow(3, std::min(lift.yaw_start, lift.yaw_goal) - M_PI / 2);
+  b.setHigh(3, std::max(lift.yaw_start, lift.yaw_goal) + M_PI / 2);
+  b.setLow(4, 0.0);
+  b.setHigh(4, 1.0);
+  space->setBounds(b);
+  const unsigned seed = o.seed;
+  space->setStateSamplerAllocator([seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  og::SimpleSetup ss(space);
+  auto si = ss.getSpaceInformation();
+  auto validity = std::make_shared<RelaxedValidity>(si, sc, lift, o.penetration);
+  ss.setStateValidityChecker(validity);
+  si->setStateValidityCheckingResolution(0.01);  // 1% of the space's extent per check along a motion
+
+  ob::ScopedState<ob::RealVectorStateSpace> start(space), target(space);
+  const double sv[5] = {sc.start.base_position.x(), sc.start.base_position.y(), sc.start.base_position.z(),
+                        lift.yaw_start, 0.0};
+  const double gv[5] = {goal.base_position.x(), goal.base_position.y(), goal.base_position.z(), lift.yaw_goal, 1.0};
+  for (int k = 0; k < 5; ++k) start[k] = sv[k], target[k] = gv[k];
+  if (!validity->isValid(start.get())) {
+    out.status = GuideResult::Status::InvalidStart;
+    out.reason = "the start posture penetrates the scene by more than " + std::to_string(o.penetration) + " m";
+    return out;
+  }
+  if (!validity->isValid(target.get())) {
+    out.status = GuideResult::Status::NoGoalPosture;
+    out.reason = "the goal posture penetrates the scene";
+    return out;
+  }
+  ss.setStartAndGoalStates(start, target);
+  auto planner = std::make_shared<SeededRRTConnect>(si, seed);
+  planner->setRange(o.range);
+  ss.setPlanner(planner);
+  ss.setup();
+  const double t1 = now();
+  const double budget = o.max_seconds;
+  const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition([&] {
+    return now() - t1 > budget || (cancel && cancel->load());
+  }));
+  out.path_seconds = now() - t1;
+  if (cancel && cancel->load()) {
+    out.status = GuideResult::Status::Cancelled;
+    out.reason = "cancelled";
+    return out;
+  }
+  if (st != ob::PlannerStatus::EXACT_SOLUTION) {
+    out.status = GuideResult::Status::NoPath;
+    out.reason = "OMPL (RRTConnect) found no path to the goal posture within " + std::to_string(budget) + " s";
+    return out;
+  }
+  og::PathGeometric path = ss.getSolutionPath();
+  out.path_vertices = static_cast<int>(path.getStateCount());
+  SeededSimplifier simplifier(si, seed);
+  simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+  simplifier.shortcutPath(path, static_cast<unsigned>(o.shortcut_steps));
+  simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+
+  Guide& g = out.guide;
+  g.source = "ompl";
+  g.scenario = sc.path;
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+    const double* s = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
+    Configuration q = i == 0 ? sc.start : (i + 1 == path.getStateCount() ? goal : lift(s));
+    // Consecutive key postures must differ in their base (the guide's base
+    // projection is one-to-one).
+    if (!g.key_postures.empty() &&
+        (q.base_position - g.key_postures.back().base_position).norm() < 0.01 &&
+        q.base_orientation.angularDistance(g.key_postures.back().base_orientation) < 0.02)
+      continue;
+    g.key_postures.push_back(q);
+  }
+  if (g.key_postures.size() < 2) {
+    out.status = GuideResult::Status::NoPath;
+    out.reason = "the goal posture's base is the start's: nothing to guide";
+    return out;
+  }
+  g.seconds = now() - t0;
+  out.status = GuideResult::Status::Success;
+  return out;
+}
+
+}  // namespace acyclic

@@ -1,0 +1,44 @@
+#pragma once
+// The rough-trajectory author (issue 7): the paper's guide was written by
+// hand; here OMPL writes it. From the scenario's start configuration to a
+// standing posture in the goal region (made by the posture generator), it
+// plans in a reduced space - the base's position and heading, and a blend
+// parameter alpha that carries every other coordinate from the start
+// posture to the goal posture - with FCL checking the scene against robot
+// geometry that may penetrate it by a few centimetres (a rough trajectory
+// may graze obstacles, paper 2.7). The path is shortcut and its vertices
+// lifted to whole-body key postures. Seeded: same scenario and seed, same
+// guide. Failures return a status with a reason.
+#include <atomic>
+#include <string>
+
+#include "planner/plan/guide.h"
+
+namespace acyclic {
+
+struct GuideOptions {
+  double penetration = 0.03;    // m: robot-environment penetration allowed along the rough trajectory
+  double max_seconds = 10;      // wall time for OMPL's search
+  double range = 0.2;           // RRTConnect's range, in the reduced space's metric
+  int shortcut_steps = 300;     // PathSimplifier attempts (counts, not time: deterministic)
+  double goal_margin = 0.05;    // m: how far past the goal's bound the goal posture stands
+  double goal_search = 0.6;     // m: the goal posture's free coordinate tried within +- this of the start's
+  std::string standing_posture = "half_sitting";  // the robot's named posture the goal posture starts from
+  unsigned seed = 1;
+};
+
+struct GuideResult {
+  enum class Status { Success, InvalidStart, NoGoalPosture, NoPath, Cancelled };
+  Status status = Status::InvalidStart;
+  std::string reason;
+  Guide guide;                  // on success
+  int path_vertices = 0;        // before shortcutting
+  double goal_seconds = 0, path_seconds = 0;
+  bool success() const { return status == Status::Success; }
+};
+
+const char* toString(GuideResult::Status s);
+
+GuideResult authorGuide(const Scenario& sc, const GuideOptions& options, const std::atomic<bool>* cancel = nullptr);
+
+}  // namespace acyclic

@@ -1,0 +1,57 @@
+// acyclic-guide: authors a scenario's rough trajectory (its key postures)
+// with OMPL and writes it as acyclic.guide/1, for acyclic-planner --guide.
+// Exit: 0 written, 1 no guide (reason printed), 2 bad input.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+#include "planner/common/format_error.h"
+#include "planner/guide/guide_author.h"
+#include "processes/lcm_process.h"
+
+using namespace acyclic;
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Authors a scenario's rough trajectory with OMPL (the paper wrote it by hand): a standing posture\n"
+      "in the goal region from the posture generator, then RRTConnect in (base position, heading, blend\n"
+      "from the start posture to the goal posture) with FCL against the scene, the robot allowed to\n"
+      "graze obstacles by --penetration; the path shortcut and lifted to whole-body key postures.\n"
+      "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
+      "Exit status: 0 written, 1 no guide (reason printed), 2 bad input."};
+  std::string in, out;
+  GuideOptions o;
+  long seed = -1;
+  app.add_option("--in", in, "scenario file (acyclic.scenario/1)")->required();
+  app.add_option("--out", out, "guide file to write (acyclic.guide/1)")->required();
+  app.add_option("--seed", seed, "seed (default: the scenario's)");
+  app.add_option("--max-seconds", o.max_seconds, "OMPL search budget, s")->capture_default_str();
+  app.add_option("--penetration", o.penetration, "robot-scene penetration allowed along the guide, m")
+      ->capture_default_str();
+  app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  proc::installSignalHandlers();
+  try {
+    const Scenario sc = Scenario::load(in);
+    o.seed = static_cast<unsigned>(seed >= 0 ? seed : static_cast<long>(sc.seed));
+    const GuideResult r = authorGuide(sc, o, &proc::stopFlag());
+    if (!r.success()) {
+      std::printf("acyclic-guide: %s: %s: %s\n", sc.name.c_str(), toString(r.status), r.reason.c_str());
+      return 1;
+    }
+    Guide g = r.guide;
+    g.scenario = in;
+    writeGuide(g, sc, out);
+    std::printf("acyclic-guide: %s: %zu key postures (path of %d vertices shortcut) in %.2f s "
+                "(goal posture %.2f s, OMPL %.2f s), written to %s\n",
+                sc.name.c_str(), g.key_postures.size(), r.path_vertices, g.seconds, r.goal_seconds, r.path_seconds,
+                out.c_str());
+    return 0;
+  } catch (const FormatError& e) {
+    std::fprintf(stderr, "acyclic-guide: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "acyclic-guide: error: %s\n", e.what());
+    return 2;
+  }
+}
