@@ -53,12 +53,13 @@ void BridgeConfig::validate() const {
 BridgeConfig BridgeConfig::load(const std::string& path) {
   const YamlField root = YamlField::loadFile(path);
   root.requireFormat("acyclic.hrp2_bridge/1");
-  std::vector<std::string> allowed = {"format"};
+  std::vector<std::string> allowed = {"format", "check_contract"};
   for (const auto& f : fields()) allowed.push_back(f.first);
   root.allowOnly(allowed);
   BridgeConfig c;
   for (const auto& [name, member] : fields())
     if (root.has(name)) c.*member = root[name].number();
+  if (root.has("check_contract")) c.check_contract = root["check_contract"].boolean();
   for (const auto& [name, member] : fields()) {
     const std::string why = checkValue(c, name, c.*member);
     if (why.empty()) continue;

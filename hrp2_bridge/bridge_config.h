@@ -23,6 +23,7 @@ struct BridgeConfig {
   double stabilizer_lag = 0.10;       // s, back on this long after the last one is released
   double coplanar_tolerance = 1e-3;   // m and rad: two surfaces are one plane within this
   double status_period = 0.05;        // s, HRP2_BRIDGE_STATUS rate (20 Hz)
+  bool check_contract = true;         // also the validity contract (contract_check.h) before streaming
 
   // Throws std::invalid_argument naming the first bad value.
   void validate() const;

@@ -27,6 +27,7 @@
 #include "acyclic/trajectory_t.hpp"
 #include "channels.hpp"
 #include "hrp2_bridge/bridge.h"
+#include "hrp2_bridge/contract_check.h"
 #include "hrp2_bridge/periodic_loop.h"
 #include "hrp2_bridge/trajectory_file.h"
 #include "processes/lcm_convert.h"
@@ -88,7 +89,8 @@ int main(int argc, char** argv) {
       "latest only) and HRP2_ESTOP; publishes HRP2_COMMAND every controller period while it commands the\n"
       "robot, HRP2_BRIDGE_STATUS (idle, checking, streaming, holding, stopped, fault) at a steady rate and\n"
       "ACYCLIC_STATUS at 1 Hz. Before streaming: joint positions, velocities and steps against the model's\n"
-      "limits (refused with the reason, never clamped), the start against the measured posture, and the\n"
+      "limits (refused with the reason, never clamped), the validity contract (every sample a valid posture\n"
+      "with its contacts; check_contract in the configuration), the start against the measured posture, and the\n"
       "start guard (servo on, robot at rest, no other command source). While streaming: stale state or a\n"
       "stalled controller -> holding; tracking error or a bad measured state -> fault; HRP2_ESTOP engage\n"
       "freezes, release blends back. A trajectory that arrives while one is checked or streamed is refused,\n"
@@ -190,7 +192,7 @@ int main(int argc, char** argv) {
     auto done = std::make_shared<std::atomic<bool>>(false);
     checks.emplace_back(std::thread([&, id, done, tr = std::move(tr)] {
       hrp2::setBackgroundPriority(rt_priority > 0);
-      hrp2::PrepareResult r = hrp2::prepareTrajectory(tr, sc.robot, sc.scene, cfg, popt);
+      hrp2::PrepareResult r = hrp2::prepareChecked(tr, sc, cfg, popt);
       {
         std::lock_guard<std::mutex> lock(mutex);
         bridge.endCheck(id, std::move(r), hrp2::monotonicMicros());

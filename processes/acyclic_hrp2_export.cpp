@@ -7,6 +7,7 @@
 
 #include <cstdio>
 
+#include "hrp2_bridge/contract_check.h"
 #include "hrp2_bridge/prepared_trajectory.h"
 #include "hrp2_bridge/sequence_player.h"
 #include "hrp2_bridge/trajectory_file.h"
@@ -18,7 +19,8 @@ int main(int argc, char** argv) {
       "Exports a trajectory (acyclic.trajectory/1) to OpenHRP/hrpsys SequencePlayer files: BASENAME.pos\n"
       "(joint angles, controller order, rad), BASENAME.waist (base x y z roll pitch yaw, world) and\n"
       "BASENAME.zmp (ZMP in the waist frame), rows 't v1 ... vN' at the controller period. The trajectory\n"
-      "is checked against the robot's joint position and velocity limits first (refused, never clamped).\n"
+      "is checked against the robot's joint position and velocity limits (refused, never clamped) and against\n"
+      "the validity contract (every sample a valid posture with its contacts) first.\n"
       "Exit status: 0 written, 1 refused (reason printed), 2 bad input."};
   std::string in, out, scenario, config_path;
   double dt = 0;
@@ -45,7 +47,7 @@ int main(int argc, char** argv) {
   }
   hrp2::PrepareOptions opt;
   opt.zmp_stride = zmp_stride;
-  const hrp2::PrepareResult r = hrp2::prepareTrajectory(lt.trajectory, lt.scenario.robot, lt.scenario.scene, cfg, opt);
+  const hrp2::PrepareResult r = hrp2::prepareChecked(lt.trajectory, lt.scenario, cfg, opt);
   if (!r.check.ok) {
     std::fprintf(stderr, "acyclic-hrp2-export: %s: refused: %s\n", in.c_str(), r.check.reason.c_str());
     return 1;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "hrp2_bridge/bridge.h"
+#include "hrp2_bridge/contract_check.h"
 #include "hrp2_bridge/prepared_trajectory.h"
 #include "hrp2_bridge/references.h"
 #include "hrp2_bridge/sequence_player.h"
@@ -78,6 +79,23 @@ PreparedTrajectory prepared(const Trajectory& tr, const BridgeConfig& cfg = {}) 
 TEST(Hrp2Check, AValidTrajectoryPasses) {
   const CheckResult r = checkTrajectory(synthetic(), *chair().robot, BridgeConfig{});
   EXPECT_TRUE(r.ok) << r.reason;
+}
+
+TEST(Hrp2Check, TheValidityContractRefusesAMotionIntoTheTable) {
+  // RARM_JOINT0 -0.4 rad from the seated start: clear of the table, valid
+  // (the independent check, sample by sample); -0.5 rad: the forearm touches it.
+  BridgeConfig cfg;
+  const PrepareResult ok = prepareChecked(synthetic(1.0, 16, -0.4), chair(), cfg);
+  EXPECT_TRUE(ok.check.ok) << ok.check.reason;
+  EXPECT_FALSE(ok.prepared.samples.empty());
+  const PrepareResult bad = prepareChecked(synthetic(1.5, 16, -0.5), chair(), cfg);
+  ASSERT_FALSE(bad.check.ok);
+  EXPECT_NE(bad.check.reason.find("table_top"), std::string::npos) << bad.check.reason;
+  EXPECT_TRUE(bad.prepared.samples.empty());
+  // Within the robot's limits: only the contract sees it.
+  EXPECT_TRUE(prepareTrajectory(synthetic(1.5, 16, -0.5), chair().robot, chair().scene, cfg).check.ok);
+  cfg.check_contract = false;
+  EXPECT_TRUE(prepareChecked(synthetic(1.5, 16, -0.5), chair(), cfg).check.ok);
 }
 
 TEST(Hrp2Check, NanIsRefusedNamingSampleAndJoint) {
@@ -599,6 +617,13 @@ TEST(Hrp2Bridge, ConfigFileFieldsAreNamedOnError) {
     EXPECT_EQ(e.field(), "velocity_margin");
   }
   EXPECT_THROW(BridgeConfig::load(dir.write("typo.yaml", "format: acyclic.hrp2_bridge/1\ndtt: 0.004\n")), FormatError);
+  EXPECT_FALSE(BridgeConfig::load(dir.write("nc.yaml", "format: acyclic.hrp2_bridge/1\ncheck_contract: false\n")).check_contract);
+  try {
+    BridgeConfig::load(dir.write("nb.yaml", "format: acyclic.hrp2_bridge/1\ncheck_contract: maybe\n"));
+    FAIL() << "accepted check_contract: maybe";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.field(), "check_contract");
+  }
 }
 
 // ---------------------------------------------------------------- export

@@ -191,8 +191,10 @@ class Hrp2Processes : public ::testing::Test {
   // (bench_bridge_jitter: max wake-up delay), which the default 10 ms state
   // watchdog rightly calls stale. Tests that are not about the watchdog give
   // it 50 ms; the watchdog test keeps the default.
-  std::string tolerantConfig() {
-    return dir_.write("bridge.yaml", "format: acyclic.hrp2_bridge/1\nstate_timeout: 0.05\nstall_timeout: 0.1\n");
+  std::string tolerantConfig(bool contract = true) {
+    return dir_.write(contract ? "bridge.yaml" : "bridge-no-contract.yaml",
+                      std::string("format: acyclic.hrp2_bridge/1\nstate_timeout: 0.05\nstall_timeout: 0.1\n") +
+                          (contract ? "" : "check_contract: false\n"));
   }
   void publish(const trajectory_t& m) { lcm_->publish(channels::kTrajectory, &m); }
   trajectory_t message(const Trajectory& tr, std::int64_t id) {
@@ -227,7 +229,11 @@ double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
 TEST_F(Hrp2Processes, TrajectoryPlayedEndToEndWithTrackingErrorReported) {
   // Two phases: seated (feet and thighs: the stabilizer off), then the thighs
   // released at 0.75 s (feet only: on again 0.1 s later, the default lag).
-  Trajectory tr = armMotion(1.5, -0.5);
+  // Released while seated and moving, this is not a valid motion (no
+  // equilibrium on the feet alone, no rest at the contact change): the
+  // contract check is off for it, the schedule is what is tested. Valid
+  // motions are streamed with the check on below.
+  Trajectory tr = armMotion(1.5, -0.4);
   TrajectoryPhase feet = tr.phases[0];
   feet.contacts.resize(2);
   ASSERT_EQ(chair().robot->spots()[feet.contacts[1].spot].name, "l_sole");
@@ -236,7 +242,7 @@ TEST_F(Hrp2Processes, TrajectoryPlayedEndToEndWithTrackingErrorReported) {
   for (auto& s : tr.samples) s.phase = s.t < 0.75 - 1e-9 ? 0 : 1;
   const std::string file = trajectoryFile(tr, "arm.json");
   Child& s = sim();
-  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig()});
+  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig(false)});
   EXPECT_EQ(wait(b, 20), 0) << logs();
   serveFor(0.2);
   std::size_t streamed = 0;
@@ -282,7 +288,7 @@ TEST_F(Hrp2Processes, TrajectoryPlayedEndToEndWithTrackingErrorReported) {
 }
 
 TEST_F(Hrp2Processes, StateStopsBridgeHoldsWithinThreePeriods) {
-  const std::string file = trajectoryFile(armMotion(2.0, -0.5), "arm.json");
+  const std::string file = trajectoryFile(armMotion(2.0, -0.4), "arm.json");
   Child& s = sim({"--freeze-after", "0.5"});
   Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file});
   ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::HOLDING); }, 10)) << logs();
@@ -314,7 +320,7 @@ TEST_F(Hrp2Processes, StateStopsBridgeHoldsWithinThreePeriods) {
 }
 
 TEST_F(Hrp2Processes, EstopFreezesAndReleaseResumesToTheEnd) {
-  const Trajectory tr = armMotion(1.5, -0.5);
+  const Trajectory tr = armMotion(1.5, -0.4);
   const std::string file = trajectoryFile(tr, "arm.json");
   Child& s = sim();
   Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig()});
@@ -405,6 +411,18 @@ TEST_F(Hrp2Processes, SecondTrajectoryWhileStreamingIsRefusedNotQueued) {
   EXPECT_EQ(heard_.commands.back().request_id, 2);
   EXPECT_EQ(heard_.statuses.back().safety_events, 0);
   EXPECT_EQ(stop(b), 0) << logs();
+  EXPECT_EQ(stop(s), 0);
+}
+
+TEST_F(Hrp2Processes, AMotionIntoTheTableIsRefusedByTheContractAndNothingMoves) {
+  // Within every joint limit, but the forearm reaches the table top.
+  const std::string file = trajectoryFile(armMotion(1.5, -0.5), "into_table.json");
+  Child& s = sim();
+  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file});
+  EXPECT_EQ(wait(b, 20), 1) << logs();
+  EXPECT_NE(test::readFile(b.log).find("table_top"), std::string::npos) << logs();
+  serveFor(0.1);
+  EXPECT_TRUE(heard_.commands.empty());
   EXPECT_EQ(stop(s), 0);
 }
 

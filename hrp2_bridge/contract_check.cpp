@@ -1,0 +1,30 @@
+#include "hrp2_bridge/contract_check.h"
+
+#include "planner/check/trajectory_check.h"
+
+namespace acyclic::hrp2 {
+
+CheckResult checkContract(const Trajectory& tr, const Scenario& sc) {
+  ValidityChecker checker(sc.robot, sc.scene);
+  TrajectoryCheckOptions opt;
+  opt.max_violations = 1;
+  const TrajectoryReport rep = acyclic::checkTrajectory(tr, sc, checker, opt);
+  if (rep.valid()) return {};
+  for (const TrajectoryCheckPart& p : rep.parts)
+    if (!p.ok())
+      return CheckResult::failure("validity contract: " + p.name + ": " + std::to_string(p.violation_count) +
+                                  " violation(s), first: " + (p.violations.empty() ? p.summary : p.violations.front()));
+  return CheckResult::failure("validity contract violated");
+}
+
+PrepareResult prepareChecked(const Trajectory& tr, const Scenario& sc, const BridgeConfig& config,
+                             const PrepareOptions& options) {
+  PrepareResult r = prepareTrajectory(tr, sc.robot, sc.scene, config, options);
+  if (r.check.ok && config.check_contract) {
+    CheckResult c = checkContract(tr, sc);
+    if (!c.ok) r = PrepareResult{std::move(c), {}};
+  }
+  return r;
+}
+
+}  // namespace acyclic::hrp2
