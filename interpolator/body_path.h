@@ -28,6 +28,9 @@ class BodyPath {
   double leaveParameter(double clearance) const;
   // Whether s lies on a straight part (near a surface: orientation held).
   bool straightAt(double s) const;
+  // Where the straight parts meet the spline (0 and 1 when an end has none).
+  double liftEndParameter() const { return length() > 0 ? lift0_ / length() : 0.0; }
+  double arriveStartParameter() const { return length() > 0 ? 1.0 - lift1_ / length() : 1.0; }
   double arriveParameter(double clearance) const;
 
   // The same ends with two via-points, at a third and two thirds of the way,

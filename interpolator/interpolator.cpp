@@ -91,6 +91,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
   to.posture.ipopt_options = opt.posture_ipopt_options;
+  to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap};
   TransitionSolver solver(sc, to);
   Trajectory& tr = res.trajectory;
   tr.scenario = plan.scenario;

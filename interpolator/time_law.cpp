@@ -48,6 +48,16 @@ TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel
   steps_ = total_ > 0 ? static_cast<int>(std::ceil(kPeakRate * total_ / dt_ - 1e-9)) : 0;
 }
 
+int TimedPiece::segmentAt(double t) const {
+  if (steps_ == 0 || knots_.size() < 2) return 0;
+  const double tau = std::clamp(t / duration(), 0.0, 1.0);
+  const double u = tau * tau * tau * (10 - 15 * tau + 6 * tau * tau) * total_;
+  std::size_t k = std::upper_bound(cum_.begin(), cum_.end(), u) - cum_.begin();
+  k = std::clamp<std::size_t>(k, 1, seg_.size()) - 1;
+  while (k + 1 < seg_.size() && seg_[k] == 0) ++k;
+  return static_cast<int>(k);
+}
+
 Configuration TimedPiece::at(double t, Eigen::VectorXd* dq) const {
   const int nj = static_cast<int>(knots_.front().joints.size());
   if (dq) *dq = Eigen::VectorXd::Zero(nj);
@@ -57,9 +67,7 @@ Configuration TimedPiece::at(double t, Eigen::VectorXd* dq) const {
   const double s = tau * tau * tau * (10 - 15 * tau + 6 * tau * tau);
   const double ds = 30 * tau * tau * (1 - tau) * (1 - tau);  // ds/dtau
   const double u = s * total_;
-  std::size_t k = std::upper_bound(cum_.begin(), cum_.end(), u) - cum_.begin();
-  k = std::clamp<std::size_t>(k, 1, seg_.size()) - 1;
-  while (k + 1 < seg_.size() && seg_[k] == 0) ++k;
+  const std::size_t k = static_cast<std::size_t>(segmentAt(t));
   const double f = seg_[k] > 0 ? std::clamp((u - cum_[k]) / seg_[k], 0.0, 1.0) : 1.0;
   if (dq && seg_[k] > 0) {
     const double du_dt = total_ * ds / T;

@@ -31,6 +31,8 @@ class TimedPiece {
   double duration() const { return steps_ * dt_; }
   // Configuration and joint velocities at time t in [0, duration()].
   Configuration at(double t, Eigen::VectorXd* dq = nullptr) const;
+  // The knot segment (k: between knots k and k + 1) that at(t) interpolates.
+  int segmentAt(double t) const;
 
   static constexpr double kPeakRate = 1.875;  // max ds/dtau of the quintic profile
 

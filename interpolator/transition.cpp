@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <set>
 
 #include "interpolator/time_law.h"
 #include "planner/common/geometry.h"
@@ -27,6 +28,13 @@ std::vector<ContactSpec> missingFrom(const std::vector<ContactSpec>& a, const st
   }
   return out;
 }
+
+// A body pivoting off its surface, where the contact changes: clear of the
+// surface by kTouchMargin, its spot origin within kTouchAcross (in the plane)
+// and kTouchAlong (along the normal) of the touch point, its normal within
+// kTouchTilt (a bound on each orientation row): 0.73 mm and 0.81 degree at
+// worst, inside the contract's 1 mm and 1 degree.
+constexpr double kTouchMargin = 5e-5, kTouchAcross = 3e-4, kTouchAlong = 1e-4, kTouchTilt = 0.01;
 
 std::string pair(int a, int b) { return "stances " + std::to_string(a) + " -> " + std::to_string(b); }
 
@@ -125,20 +133,26 @@ struct Refiner {
   int* refinements;
   std::string* reason;
 
+  int checks;  // points checked inside each segment, equally spaced
+
   bool midValid(const Configuration& a, const Configuration& b, std::string* why) {
-    const ValidityReport r = checker.checkPosture(lerp(a, b, 0.5), contacts);
-    if (r.valid()) return true;
-    for (const auto& p : r.parts)
-      if (p.checked && !p.ok()) *why = p.name + ": " + p.violations[0];
-    return false;
+    for (int i = 1; i <= checks; ++i) {
+      const ValidityReport r = checker.checkPosture(lerp(a, b, static_cast<double>(i) / (checks + 1)), contacts);
+      if (r.valid()) continue;
+      for (const auto& p : r.parts)
+        if (p.checked && !p.ok()) *why = p.name + ": " + p.violations[0];
+      return false;
+    }
+    return true;
   }
 
   // Appends the refined knots strictly after (pa, a) up to and including (pb, b).
   bool segment(double pa, const Configuration& a, double pb, const Configuration& b, int level,
-               std::vector<Configuration>& out) {
+               std::vector<Configuration>& out, std::vector<double>& out_params) {
     std::string why;
     if (midValid(a, b, &why)) {
       out.push_back(b);
+      out_params.push_back(pb);
       return true;
     }
     if (level >= depth) {
@@ -149,15 +163,51 @@ struct Refiner {
     const std::optional<Configuration> m = solveAt(pm, lerp(a, b, 0.5));
     if (!m) return false;
     ++*refinements;
-    return segment(pa, a, pm, *m, level + 1, out) && segment(pm, *m, pb, b, level + 1, out);
+    return segment(pa, a, pm, *m, level + 1, out, out_params) && segment(pm, *m, pb, b, level + 1, out, out_params);
   }
 
   bool refine(const std::vector<double>& params, const std::vector<Configuration>& knots,
-              std::vector<Configuration>& out) {
+              std::vector<Configuration>& out, std::vector<double>& out_params) {
     out = {knots.front()};
+    out_params = {params.front()};
     for (std::size_t k = 0; k + 1 < knots.size(); ++k)
-      if (!segment(params[k], knots[k], params[k + 1], knots[k + 1], 0, out)) return false;
+      if (!segment(params[k], knots[k], params[k + 1], knots[k + 1], 0, out, out_params)) return false;
     return true;
+  }
+
+  // Every sample the time law makes of these knots, checked; the segment of a
+  // failing sample gets a knot in its middle, up to `depth` rounds. This is
+  // what makes every output sample valid, not only the checked points.
+  bool verify(std::vector<double>& params, std::vector<Configuration>& knots, const TimeLawOptions& tl,
+              const RobotModel& robot, Kinematics& kin) {
+    for (int round = 0;; ++round) {
+      const TimedPiece tp(knots, robot, kin, tl);
+      std::set<int> bad;
+      std::string why;
+      for (int i = 0; i <= tp.steps(); ++i) {
+        const int seg = tp.segmentAt(i * tl.dt);
+        if (bad.count(seg)) continue;
+        const ValidityReport r = checker.checkPosture(tp.at(i * tl.dt), contacts);
+        if (r.valid()) continue;
+        bad.insert(seg);
+        for (const auto& p : r.parts)
+          if (p.checked && !p.ok()) why = p.name + ": " + p.violations[0];
+      }
+      if (bad.empty()) return true;
+      if (round >= depth) {
+        *reason = "a sample between two knots, after " + std::to_string(depth) + " rounds of refinement: " + why;
+        return false;
+      }
+      for (auto it = bad.rbegin(); it != bad.rend(); ++it) {  // from the last, so that indices stay valid
+        const int k = *it;
+        const double pm = 0.5 * (params[k] + params[k + 1]);
+        const std::optional<Configuration> m = solveAt(pm, lerp(knots[k], knots[k + 1], 0.5));
+        if (!m) return false;
+        ++*refinements;
+        knots.insert(knots.begin() + k + 1, *m);
+        params.insert(params.begin() + k + 1, pm);
+      }
+    }
   }
 };
 
@@ -178,7 +228,16 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     e1.pose = kin_.spotPose(d.spot);
     if (d.leave) e0.normal = sc_.scene->surfaces()[d.leave->surface].frame.linear().col(2);
     if (d.arrive) e1.normal = sc_.scene->surfaces()[d.arrive->surface].frame.linear().col(2);
-    const BodyPath path(e0, e1, opt_.lift);
+    // A body that only leaves (or only reaches) a surface and is, in the other
+    // witness, already less than the lift above it rises no higher than that:
+    // a thigh leaving the seat with its foot planted cannot rise 3 cm.
+    double lift = opt_.lift;
+    auto heightOver = [](const BodyPathEnd& on, const BodyPathEnd& other) {
+      return on.normal->dot(other.pose.translation() - on.pose.translation());
+    };
+    const double h = d.leave && !d.arrive ? heightOver(e0, e1) : d.arrive && !d.leave ? heightOver(e1, e0) : -1;
+    if (h > 0 && h < lift) lift = std::max(h, 2 * opt_.touch_clearance);
+    const BodyPath path(e0, e1, lift);
     std::string reasons;
     for (int attempt = 0; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt) {
       at.pieces.clear();
@@ -255,8 +314,10 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, A
   MotionPiece piece;
   piece.contacts = d.motion_contacts;
   piece.stance = d.motion_stance;
-  Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason};
-  if (!ref.refine(params, knots, piece.knots)) return false;
+  Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks};
+  std::vector<double> piece_params;
+  if (!ref.refine(params, knots, piece.knots, piece_params)) return false;
+  if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;
   at.pieces.push_back(std::move(piece));
   return true;
 }
@@ -267,64 +328,114 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
   std::vector<int> touch;
   if (d.leave) touch.push_back(sc_.scene->surfaces()[d.leave->surface].obstacle);
   if (d.arrive) touch.push_back(sc_.scene->surfaces()[d.arrive->surface].obstacle);
+  const double s0 = path.leaveParameter(opt_.touch_clearance), s1 = path.arriveParameter(opt_.touch_clearance);
+  bool loose_only = false;
   auto solveAt = [&](double s, const Configuration& guess) -> std::optional<Configuration> {
     if (at.cancel && at.cancel->load()) {
       at.cancelled = true;
       at.reason = "cancelled";
       return std::nullopt;
     }
-    PostureRequest r;
-    r.contacts = d.motion_contacts;
+    const Configuration ref = lerp(q0, q1, s);
+    // Cost: the squared distance to the witnesses' interpolation plus the
+    // squared distance to the neighbouring knot (the guess), i.e. the distance
+    // to their midpoint: the knots stay on one branch of the body's inverse
+    // kinematics instead of jumping between them.
+    const auto cost = std::make_shared<ReferencePostureCost>(lerp(guess, ref, 0.5));
+    auto attempt = [&](const PoseTarget& t, const Configuration& g) {
+      PostureRequest r;
+      r.contacts = d.motion_contacts;
+      r.pose_target = t;
+      r.initial_guess = g;
+      r.cost = cost;
+      PostureResult res = generator_.solve(r);
+      ++at.posture_calls;
+      at.posture_seconds += res.seconds;
+      return res;
+    };
     PoseTarget t;
     t.spot = d.spot;
     t.pose = path.pose(s);
     t.touch_obstacles = touch;
-    t.orientation_tolerance = path.straightAt(s) ? 0.0 : opt_.air_orientation_tolerance;
-    r.pose_target = t;
-    r.initial_guess = guess;
-    const Configuration ref = lerp(q0, q1, s);
-    r.cost = std::make_shared<ReferencePostureCost>(ref);
-    PostureResult res = generator_.solve(r);
-    ++at.posture_calls;
-    at.posture_seconds += res.seconds;
-    if (!res.success()) {
-      r.initial_guess = ref;
-      res = generator_.solve(r);
-      ++at.posture_calls;
-      at.posture_seconds += res.seconds;
+    std::vector<PoseTarget> targets;
+    if (!path.straightAt(s)) {  // in the air
+      t.orientation_tolerance = opt_.air_orientation_tolerance;
+      targets.push_back(t);
+      // A body that had to pivot off its surface (held at its other end)
+      // cannot follow every point of a spline either: within straight_slack
+      // of it. (Any other body follows it exactly, or the path is repaired.)
+      if (loose_only) {
+        PoseTarget loose = t;
+        loose.touch_margin = kTouchMargin;
+        loose.position_tolerance.setConstant(opt_.straight_slack);
+        targets.push_back(loose);
+      }
+    } else {
+      // Near the surface: first exactly on the path (straight along the
+      // normal, orientation held: a sole or a palm leaves flat).
+      targets.push_back(t);
+      // A body whose other end is held cannot: a thigh with its foot planted
+      // has its knee move across the shank only, so it pivots off the seat.
+      // Then only the height along the normal is held, the body clear of the surface.
+      PoseTarget loose = t;
+      loose.touch_margin = kTouchMargin;
+      if ((d.leave && s == s0) || (d.arrive && s == s1)) {
+        // Where the contact changes: within the contract's contact tolerances too.
+        loose.position_tolerance = Eigen::Vector3d(kTouchAcross, kTouchAcross, kTouchAlong);
+        loose.orientation_tolerance = kTouchTilt;
+      } else {
+        loose.position_tolerance = Eigen::Vector3d(opt_.straight_slack, opt_.straight_slack, 0);
+        loose.orientation_tolerance = opt_.air_orientation_tolerance;
+      }
+      targets.push_back(loose);
     }
-    if (!res.success()) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "no posture at path parameter %.3f: ", s);
-      at.reason = buf + res.reason;
-      return std::nullopt;
+    // Once the body could not follow its path exactly, the rest of this
+    // attempt uses the slack at once (the same body, the same constraint).
+    if (loose_only) targets.erase(targets.begin());
+    PostureResult res;
+    for (std::size_t k = 0; k < targets.size(); ++k) {
+      res = attempt(targets[k], guess);
+      if (!res.success()) res = attempt(targets[k], ref);  // from the interpolated witnesses instead of the previous step
+      if (res.success()) {
+        loose_only = loose_only || k > 0;
+        return res.configuration;
+      }
     }
-    return res.configuration;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "no posture at path parameter %.3f: ", s);
+    at.reason = buf + res.reason;
+    return std::nullopt;
   };
-  const double s0 = path.leaveParameter(opt_.touch_clearance), s1 = path.arriveParameter(opt_.touch_clearance);
-  // The knots in the air (the first and last only touch their surfaces when the body has none to leave or reach).
+  // The knots in the air (the first and last only touch their surfaces when
+  // the body has none to leave or reach): n steps, and the two ends of the
+  // spline, so that the straight parts are interpolated between knots on them.
   std::vector<double> params;
+  for (int i = 0; i <= opt_.steps; ++i) params.push_back(i == opt_.steps ? s1 : s0 + (s1 - s0) * i / opt_.steps);
+  for (double j : {path.liftEndParameter(), path.arriveStartParameter()})
+    if (j > s0 + 1e-6 && j < s1 - 1e-6) params.push_back(j);
+  std::sort(params.begin(), params.end());
+  params.erase(std::unique(params.begin(), params.end(), [](double a, double b) { return b - a < 1e-6; }), params.end());
   std::vector<Configuration> knots;
-  for (int i = 0; i <= opt_.steps; ++i) {
-    const double s = s0 + (s1 - s0) * i / opt_.steps;
+  for (std::size_t i = 0; i < params.size(); ++i) {
     if (i == 0 && !d.leave) {
       knots.push_back(q0);
-    } else if (i == opt_.steps && !d.arrive) {
+    } else if (i + 1 == params.size() && !d.arrive) {
       knots.push_back(q1);
     } else {
-      const auto k = solveAt(s, knots.empty() ? q0 : knots.back());
+      const auto k = solveAt(params[i], knots.empty() ? q0 : knots.back());
       if (!k) return false;
       knots.push_back(*k);
     }
-    params.push_back(s);
   }
   auto addPiece = [&](std::vector<double> ps, std::vector<Configuration> ks, const std::vector<ContactSpec>& contacts,
                       int stance) {
     MotionPiece piece;
     piece.contacts = contacts;
     piece.stance = stance;
-    Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason};
-    if (!ref.refine(ps, ks, piece.knots)) return false;
+    Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks};
+    std::vector<double> piece_params;
+    if (!ref.refine(ps, ks, piece.knots, piece_params)) return false;
+    if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;
     at.pieces.push_back(std::move(piece));
     return true;
   };

@@ -17,7 +17,9 @@
 //          keeps the contact: the phase changes when it is `touch_clearance`
 //          off the surface, where no check can mistake it for a collision.
 // Between knots, the linear interpolation is checked at each segment's middle
-// by the independent validity check and refined where it fails. A Move whose
+// by the independent validity check and refined where it fails; then every
+// sample the time law makes of the piece is checked the same way, and the
+// segment of a failing sample refined (so every output sample is valid). A Move whose
 // path collides (a knot infeasible, or a middle that refinement cannot fix) is
 // repaired by raising a via-point, higher on each attempt.
 #include <atomic>
@@ -27,6 +29,7 @@
 #include <vector>
 
 #include "interpolator/body_path.h"
+#include "interpolator/time_law.h"
 #include "planner/check/validity.h"
 #include "planner/plan/plan.h"
 #include "planner/posture/posture_generator.h"
@@ -64,9 +67,18 @@ struct TransitionOptions {
   // within this bound on each orientation row (PoseTarget); on the straight
   // parts, near a surface, exactly.
   double air_orientation_tolerance = 0.3;
+  // Near a surface, when the body cannot move straight with its orientation
+  // held (a thigh whose foot is planted pivots), its spot origin may leave
+  // the straight line by this much across the normal (m), its height held.
+  double straight_slack = 0.005;
   int repair_attempts = 4;
   double repair_step = 0.05;         // m: via-point height added per attempt
-  int refine_depth = 3;              // halvings of a segment whose middle fails the check
+  int refine_depth = 3;              // halvings of a segment whose inside fails the check
+  int segment_checks = 1;            // points checked inside each segment before timing (its middle)
+  // After timing, every sample the piece will give is checked, and refined
+  // where one fails (with timing: the time law the interpolator uses).
+  bool verify_samples = true;
+  TimeLawOptions timing;
   PostureGeneratorOptions posture;
 };
 

@@ -304,6 +304,7 @@ TEST(Interpolator, HandReachesTheTableAndLeavesIt) {
   const Plan plan = handPlan();
   InterpolatorOptions opt;
   opt.filter = false;
+  opt.steps = 10;  // the behaviour, not the resolution, is under test: half the posture calls
   const InterpolationResult r = interpolate(plan, sc, opt);
   ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
   const Trajectory& tr = r.trajectory;
@@ -362,6 +363,29 @@ TEST(Interpolator, CollidingStepIsRepairedByRaisingThePath) {
   EXPECT_EQ(u.failed_stances, (std::vector<int>{1, 3}));
   EXPECT_NE(u.reason.find("stances 1 -> 3"), std::string::npos) << u.reason;
   EXPECT_TRUE(u.trajectory.samples.empty());
+}
+
+TEST(Interpolator, ThighPivotsOffTheSeatWithItsFootPlanted) {
+  // tests/data/chair_palm_thigh.plan.json: seated, the left palm reaches the
+  // table and takes weight, then the left thigh is unloaded and leaves the
+  // seat. A thigh whose foot stays planted cannot rise straight with its
+  // orientation held (its knee moves across the shank only): it pivots.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_palm_thigh.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 5u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  opt.steps = 10;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  expectValid(r.trajectory, sc);
+  // The last phase holds no thigh contact on the left, and the thigh is off the seat there.
+  const TrajectoryPhase& last = r.trajectory.phases.back();
+  const int l_thigh = sc.robot->spotIndex("l_thigh");
+  for (const auto& c : last.contacts) EXPECT_NE(c.spot, l_thigh);
+  const Surface& seat = sc.scene->surfaces()[sc.scene->surfaceIndex("chair_seat")];
+  const double rise = (seat.frame.inverse() * spotAt(sc, r.trajectory.samples.back().q, l_thigh).translation()).z();
+  EXPECT_GT(rise, 1e-3);
 }
 
 TEST(Interpolator, BadInputAndCancellation) {

@@ -254,6 +254,19 @@ TEST(PostureGenerator, PoseTargetOrientationTolerance) {
   // The bound is checked: outside [0, 1) the request is refused.
   r.pose_target->orientation_tolerance = 1.5;
   EXPECT_EQ(pg.solve(r).status, PostureResult::Status::BadInput);
+  // Position bounds in the target's frame: held within 1 cm across its z, exactly along it.
+  r.pose_target->orientation_tolerance = 0.3;
+  r.pose_target->pose.translation() += t.pose.linear() * Eigen::Vector3d(0.05, 0, 0);  // 5 cm off along its x
+  r.pose_target->position_tolerance = Eigen::Vector3d(0.01, 0.01, 0);
+  const PostureResult boxed = pg.solve(r);
+  ASSERT_TRUE(boxed.success()) << boxed.reason;
+  k.setConfiguration(boxed.configuration);
+  const Eigen::Vector3d off = r.pose_target->pose.linear().transpose() *
+                              (k.spotPose(t.spot).translation() - r.pose_target->pose.translation());
+  EXPECT_LE(std::abs(off.x()), 0.01 + 1e-6);
+  EXPECT_LE(std::abs(off.y()), 0.01 + 1e-6);
+  EXPECT_LE(std::abs(off.z()), 1e-6);
+  expectValid(sc, boxed, sc.start_stance);
 }
 
 TEST(PostureProblem, StaticsRowsAreSimbodysGravityTorques) {

@@ -85,9 +85,11 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
     if (!t.pose.matrix().allFinite()) throw std::invalid_argument("pose target has a non-finite value");
     if (!(t.orientation_tolerance >= 0 && t.orientation_tolerance < 1))
       throw std::invalid_argument("pose target: orientation tolerance outside [0, 1)");
+    if (!(t.position_tolerance.minCoeff() >= 0) || !(t.touch_margin >= 0 && t.touch_margin <= opt_.collision_margin))
+      throw std::invalid_argument("pose target: negative position tolerance, or touch margin outside [0, collision margin]");
     for (int o : t.touch_obstacles) {
       if (o < 0 || o >= static_cast<int>(scene_->obstacles().size())) throw std::invalid_argument("unknown obstacle");
-      allowed_touch_.push_back({robot_->spots()[t.spot].link, o});
+      near_touch_.push_back({robot_->spots()[t.spot].link, o});
     }
   }
 
@@ -236,8 +238,10 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
       for (double bi : b) gl[r] = -kInf, gu[r++] = bi - kFloatingPolygonMargin;
   }
   if (req_.pose_target) {
+    const PoseTarget& t = *req_.pose_target;
     const int r = 6 * (numContacts() - 1);  // the pose target's rows come last among the contacts'
-    for (int k = 3; k < 6; ++k) gl[r + k] = -req_.pose_target->orientation_tolerance, gu[r + k] = req_.pose_target->orientation_tolerance;
+    for (int k = 0; k < 3; ++k) gl[r + k] = -t.position_tolerance[k], gu[r + k] = t.position_tolerance[k];
+    for (int k = 3; k < 6; ++k) gl[r + k] = -t.orientation_tolerance, gu[r + k] = t.orientation_tolerance;
   }
   for (const auto& j : robot_->joints()) {
     const double W = robot_->totalMass() * 9.81;  // statics rows are in units of the weight
@@ -245,7 +249,11 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
     gu[row_statics_ + 6 + j.index] = opt_.torque_share * j.effort / W;
   }
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    gl[row_collision_ + k] = opt_.collision_margin;
+    const CollisionPair& cp = collision_->pairs()[pairs_[k]];
+    bool near = false;
+    for (const auto& [link, obstacle] : near_touch_)
+      near = near || (cp.kind == CollisionPair::Kind::RobotEnvironment && cp.link_a == link && cp.obstacle == obstacle);
+    gl[row_collision_ + k] = near ? req_.pose_target->touch_margin : opt_.collision_margin;
     gu[row_collision_ + k] = kInf;
   }
 }
@@ -369,7 +377,9 @@ Eigen::MatrixXd PostureProblem::lagrangianHessian(const Eigen::VectorXd& x, doub
     const int r = 6 * ci;
     const Eigen::Vector3d zs = Ts.linear().col(2), xs = Ts.linear().col(0);
     const Eigen::Vector3d xt = T.linear().col(0), yt = T.linear().col(1);
-    addSecond(link, Ts.translation(), false, y.segment<3>(r));
+    const bool target = req_.pose_target && ci == numContacts() - 1;  // its offset rows are in its own frame
+    addSecond(link, Ts.translation(), false,
+              target ? Eigen::Vector3d(T.linear() * y.segment<3>(r)) : Eigen::Vector3d(y.segment<3>(r)));
     addSecond(link, zs, true, y[r + 3] * xt + y[r + 4] * yt);
     addSecond(link, xs, true, y[r + 5] * yt);
     if (floating) {
@@ -559,8 +569,14 @@ void PostureProblem::evaluate(const Eigen::VectorXd& x) {
     const Eigen::Isometry3d& Ts = cg.spot;
     const Eigen::Isometry3d& T = cg.target;
     const int r = 6 * ci;
-    g_.segment<3>(r) = Ts.translation() - T.translation();
-    jac_.block(r, 0, 3, nq_) = kin_.chainPointJacobian(link, Ts.translation());
+    if (req_.pose_target && ci == numContacts() - 1) {
+      // The pose target's offset in its own frame, so that it can be bounded along and across a normal.
+      g_.segment<3>(r) = T.linear().transpose() * (Ts.translation() - T.translation());
+      jac_.block(r, 0, 3, nq_) = T.linear().transpose() * kin_.chainPointJacobian(link, Ts.translation());
+    } else {
+      g_.segment<3>(r) = Ts.translation() - T.translation();
+      jac_.block(r, 0, 3, nq_) = kin_.chainPointJacobian(link, Ts.translation());
+    }
     const Eigen::Vector3d zs = Ts.linear().col(2), xs = Ts.linear().col(0);
     const Eigen::Vector3d xt = T.linear().col(0), yt = T.linear().col(1);
     const std::pair<Eigen::Vector3d, Eigen::Vector3d> axes[3] = {{zs, xt}, {zs, yt}, {xs, yt}};

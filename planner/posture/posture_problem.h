@@ -46,14 +46,20 @@ struct FloatingContact {
 };
 
 // A spot's frame held at a world pose, with no surface (the interpolator's
-// moving body): 6 rows like a contact's (origin on the pose's origin, z along
-// its z, x orthogonal to its y). Geometric only.
+// moving body): 6 rows like a contact's, the origin's offset expressed in the
+// pose's frame (so that it can be bounded along and across a surface normal),
+// z along its z, x orthogonal to its y. Geometric only.
 struct PoseTarget {
   int spot = -1;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  // Obstacles the spot's link may touch (the surfaces it leaves or reaches:
-  // near them its pose, not a collision margin, keeps it clear).
+  // Obstacles the spot's link comes close to on purpose (the surfaces it
+  // leaves or reaches): its clearance to them is at least touch_margin
+  // instead of the collision margin.
   std::vector<int> touch_obstacles;
+  double touch_margin = 0;
+  // Bounds on the origin's offset from the pose's origin, in the pose's frame
+  // (0: exactly on it).
+  Eigen::Vector3d position_tolerance = Eigen::Vector3d::Zero();
   // Bound on each orientation row (about the sine of the tilt about each
   // axis): 0 holds the orientation exactly; a body in the air needs only its
   // position on the path, its orientation roughly.
@@ -165,6 +171,7 @@ class PostureProblem {
   std::vector<Support> supports_;
   std::vector<int> pairs_;
   std::vector<std::pair<int, int>> allowed_touch_;  // (link, obstacle)
+  std::vector<std::pair<int, int>> near_touch_;     // (link, obstacle): the pose target's, at touch_margin
 
   int nq_ = 0, nx_ = 0, ng_ = 0;
   int x_float_ = -1, x_lambda_ = -1, n_lambda_ = 0;
