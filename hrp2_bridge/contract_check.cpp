@@ -4,11 +4,11 @@
 
 namespace acyclic::hrp2 {
 
-CheckResult checkContract(const Trajectory& tr, const Scenario& sc) {
+CheckResult checkContract(const Trajectory& tr, const Scenario& sc, const std::function<void(int, int)>& progress) {
   ValidityChecker checker(sc.robot, sc.scene);
   TrajectoryCheckOptions opt;
   opt.max_violations = 1;
-  const TrajectoryReport rep = acyclic::checkTrajectory(tr, sc, checker, opt);
+  const TrajectoryReport rep = acyclic::checkTrajectory(tr, sc, checker, opt, progress);
   if (rep.valid()) return {};
   for (const TrajectoryCheckPart& p : rep.parts)
     if (!p.ok())
@@ -18,10 +18,10 @@ CheckResult checkContract(const Trajectory& tr, const Scenario& sc) {
 }
 
 PrepareResult prepareChecked(const Trajectory& tr, const Scenario& sc, const BridgeConfig& config,
-                             const PrepareOptions& options) {
+                             const PrepareOptions& options, const std::function<void(int, int)>& progress) {
   PrepareResult r = prepareTrajectory(tr, sc.robot, sc.scene, config, options);
   if (r.check.ok && config.check_contract) {
-    CheckResult c = checkContract(tr, sc);
+    CheckResult c = checkContract(tr, sc, progress);
     if (!c.ok) r = PrepareResult{std::move(c), {}};
   }
   return r;

@@ -7,6 +7,8 @@
 // guards physics: a motion that would collide, lose a contact or fall is
 // refused too. It costs about a millisecond per sample, so it runs in the
 // bridge's checking state, off the control loop.
+#include <functional>
+
 #include "hrp2_bridge/prepared_trajectory.h"
 #include "hrp2_bridge/trajectory_check.h"
 #include "planner/scene/scenario.h"
@@ -14,11 +16,14 @@
 namespace acyclic::hrp2 {
 
 // ok, or refused with the number of invalid samples and the first violation.
-CheckResult checkContract(const Trajectory& tr, const Scenario& sc);
+// `progress(done, total)` is called now and then (samples checked).
+CheckResult checkContract(const Trajectory& tr, const Scenario& sc,
+                          const std::function<void(int, int)>& progress = {});
 
 // What the bridge and the exporter run: prepareTrajectory (the robot's limits
 // first: cheap), then, when config.check_contract, the contract.
 PrepareResult prepareChecked(const Trajectory& tr, const Scenario& sc, const BridgeConfig& config,
-                             const PrepareOptions& options = {});
+                             const PrepareOptions& options = {},
+                             const std::function<void(int, int)>& progress = {});
 
 }  // namespace acyclic::hrp2

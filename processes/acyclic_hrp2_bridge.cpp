@@ -192,7 +192,13 @@ int main(int argc, char** argv) {
     auto done = std::make_shared<std::atomic<bool>>(false);
     checks.emplace_back(std::thread([&, id, done, tr = std::move(tr)] {
       hrp2::setBackgroundPriority(rt_priority > 0);
+      const std::int64_t t0 = hrp2::monotonicMicros();
       hrp2::PrepareResult r = hrp2::prepareChecked(tr, sc, cfg, popt);
+      char took[120];
+      std::snprintf(took, sizeof took, "request %lld checked in %.2f s (%zu samples%s)", static_cast<long long>(id),
+                    (hrp2::monotonicMicros() - t0) * 1e-6, tr.samples.size(),
+                    cfg.check_contract ? ", limits and validity contract" : ", limits only");
+      proc::log(kName, took);
       {
         std::lock_guard<std::mutex> lock(mutex);
         bridge.endCheck(id, std::move(r), hrp2::monotonicMicros());

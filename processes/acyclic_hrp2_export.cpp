@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <unistd.h>
 
 #include "hrp2_bridge/contract_check.h"
 #include "hrp2_bridge/prepared_trajectory.h"
@@ -30,6 +31,8 @@ int main(int argc, char** argv) {
   app.add_option("--scenario", scenario, "scenario file (default: the one the trajectory names)");
   app.add_option("--config", config_path, "bridge configuration (acyclic.hrp2_bridge/1): dt, margins, stabilizer lead/lag");
   app.add_option("--dt", dt, "controller period, s (default: the configuration's, else 0.005)");
+  bool no_contract = false;
+  app.add_flag("--no-contract", no_contract, "skip the validity contract check (the limits are always checked)");
   app.add_option("--zmp-stride", zmp_stride, "quasi-static LP every N samples, interpolated between (default 10)")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
@@ -39,6 +42,7 @@ int main(int argc, char** argv) {
   try {
     if (!config_path.empty()) cfg = hrp2::BridgeConfig::load(config_path);
     if (dt != 0) cfg.dt = dt;
+    if (no_contract) cfg.check_contract = false;
     cfg.validate();
     lt = hrp2::loadTrajectoryFile(in, scenario);
   } catch (const std::exception& e) {
@@ -47,7 +51,13 @@ int main(int argc, char** argv) {
   }
   hrp2::PrepareOptions opt;
   opt.zmp_stride = zmp_stride;
-  const hrp2::PrepareResult r = hrp2::prepareChecked(lt.trajectory, lt.scenario, cfg, opt);
+  // Progress on a terminal only (the contract check takes about 2 ms a sample).
+  const bool tty = isatty(fileno(stderr));
+  auto progress = [&](int done, int total) {
+    if (tty) std::fprintf(stderr, "\racyclic-hrp2-export: checking the validity contract: %d / %d samples", done, total);
+  };
+  const hrp2::PrepareResult r = hrp2::prepareChecked(lt.trajectory, lt.scenario, cfg, opt, progress);
+  if (tty && cfg.check_contract) std::fprintf(stderr, "\n");
   if (!r.check.ok) {
     std::fprintf(stderr, "acyclic-hrp2-export: %s: refused: %s\n", in.c_str(), r.check.reason.c_str());
     return 1;
