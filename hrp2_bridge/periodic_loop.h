@@ -28,9 +28,11 @@ bool lockMemory(std::string* why = nullptr);
 // For the heavy threads of a real-time process (checks, LPs): SCHED_FIFO 1,
 // below the loops, when `realtime`; else the normal time-sharing policy.
 // Not SCHED_OTHER in a real-time process: a time-shared thread preempted
-// while it holds a lock the loop needs (malloc's arena lock, freeing memory
-// across threads) stalled the loop for 10-30 ms on a loaded machine; at
-// FIFO 1 it gets the CPU back at once and releases it.
+// while it holds a lock the loop may need (malloc's arena lock when memory is
+// freed across threads) would stall the loop until the scheduler comes back
+// to it; at FIFO 1 it gets the CPU back at once and releases the lock. (A
+// precaution: the 10-30 ms stalls seen on the shared test machine happened
+// with either policy.)
 void setBackgroundPriority(bool realtime);
 
 class PeriodicLoop {
