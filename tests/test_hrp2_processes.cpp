@@ -414,6 +414,30 @@ TEST_F(Hrp2Processes, SecondTrajectoryWhileStreamingIsRefusedNotQueued) {
   EXPECT_EQ(stop(s), 0);
 }
 
+TEST_F(Hrp2Processes, LatencyAndDroppedCommandsAreRiddenThrough) {
+  // 20 ms of latency and a fifth of the commands lost: each command supersedes
+  // the last, so the motion still plays to the end without a safety event.
+  const Trajectory tr = armMotion(1.0, -0.4);
+  const std::string file = trajectoryFile(tr, "arm.json");
+  Child& s = sim({"--latency", "0.02", "--drop-rate", "0.2", "--seed", "3"});
+  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig()});
+  EXPECT_EQ(wait(b, 20), 0) << logs();
+  serveFor(0.3);
+  const hrp2_bridge_status_t& last = heard_.statuses.back();
+  EXPECT_EQ(last.safety_events, 0) << logs();
+  EXPECT_GT(last.tracking_error_max, 0.0);
+  EXPECT_LT(last.tracking_error_max, 0.05);
+  const std::vector<double> end(tr.samples.back().q.joints.data(), tr.samples.back().q.joints.data() + 30);
+  EXPECT_LT(maxAbsDiff(heard_.states.back().q, end), 1e-3);
+  EXPECT_EQ(stop(s), 0);
+  // The simulator counted what it lost.
+  const std::string log = test::readFile(s.log);
+  const auto at = log.find(" dropped");
+  ASSERT_NE(at, std::string::npos) << log;
+  const long dropped = std::stol(log.substr(log.rfind(' ', at - 1) + 1));
+  EXPECT_GT(dropped, 10) << log;
+}
+
 TEST_F(Hrp2Processes, AMotionIntoTheTableIsRefusedByTheContractAndNothingMoves) {
   // Within every joint limit, but the forearm reaches the table top.
   const std::string file = trajectoryFile(armMotion(1.5, -0.5), "into_table.json");
