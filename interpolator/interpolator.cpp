@@ -92,6 +92,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
   to.posture.ipopt_options = opt.posture_ipopt_options;
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap};
+  to.verify_samples = opt.verify_samples;
   TransitionSolver solver(sc, to);
   Trajectory& tr = res.trajectory;
   tr.scenario = plan.scenario;

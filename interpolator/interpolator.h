@@ -29,6 +29,10 @@ struct InterpolatorOptions {
   int repair_attempts = 4;       // raised via-points tried on a colliding path
   double repair_step = 0.05;     // m: via-point height added per attempt
   int refine_depth = 3;
+  // Check every output sample with the validity contract (and refine where
+  // one fails). Off, only knots and segment middles are checked: for
+  // measuring what the verification costs, not for output.
+  bool verify_samples = true;
   // Each posture call bounded by iterations, not time: same input, same output.
   int posture_iterations = 100;
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out
