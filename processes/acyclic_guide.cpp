@@ -7,6 +7,7 @@
 
 #include "planner/common/format_error.h"
 #include "planner/guide/guide_author.h"
+#include "processes/guide_service.h"
 #include "processes/lcm_process.h"
 
 using namespace acyclic;
@@ -18,12 +19,19 @@ int main(int argc, char** argv) {
       "from the start posture to the goal posture) with FCL against the scene, the robot allowed to\n"
       "graze obstacles by --penetration; the path shortcut and lifted to whole-body key postures.\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
-      "Exit status: 0 written, 1 no guide (reason printed), 2 bad input."};
+      "File mode: --in SCENARIO --out GUIDE; exit status 0 written, 1 no guide (reason printed), 2 bad input.\n"
+      "LCM mode: --lcm answers every ACYCLIC_REQUEST whose scenario has no key postures with ACYCLIC_GUIDE\n"
+      "(same request id; the planner waits for it); ACYCLIC_STATUS at 1 Hz and on errors; ACYCLIC_CANCEL.\n"
+      "One request at a time: another is refused (ACYCLIC_GUIDE with status ERROR). Exits 0 on SIGINT/SIGTERM."};
   std::string in, out;
   GuideOptions o;
   long seed = -1;
-  app.add_option("--in", in, "scenario file (acyclic.scenario/1)")->required();
-  app.add_option("--out", out, "guide file to write (acyclic.guide/1)")->required();
+  bool lcm_mode = false;
+  std::string url = proc::defaultLcmUrl();
+  app.add_option("--in", in, "scenario file (acyclic.scenario/1), file mode");
+  app.add_option("--out", out, "guide file to write (acyclic.guide/1), file mode");
+  app.add_flag("--lcm", lcm_mode, "serve ACYCLIC_REQUEST on LCM instead of the file mode");
+  app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--seed", seed, "seed (default: the scenario's)");
   app.add_option("--max-seconds", o.max_seconds, "OMPL search budget, s")->capture_default_str();
   app.add_option("--penetration", o.penetration, "robot-scene penetration allowed along the guide, m")
@@ -31,6 +39,11 @@ int main(int argc, char** argv) {
   app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   proc::installSignalHandlers();
+  if (lcm_mode) return serveGuide(url, o);
+  if (in.empty() || out.empty()) {
+    std::fprintf(stderr, "acyclic-guide: give --in SCENARIO --out GUIDE (file mode) or --lcm; see --help\n");
+    return 2;
+  }
   try {
     const Scenario sc = Scenario::load(in);
     o.seed = static_cast<unsigned>(seed >= 0 ? seed : static_cast<long>(sc.seed));

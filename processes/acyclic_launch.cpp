@@ -82,9 +82,9 @@ std::string selfDir() {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Runs the Acyclic pipeline on one machine: lcm-logger, acyclic-planner and acyclic-interpolator\n"
-      "(each with --lcm), then sends the scenario as one ACYCLIC_REQUEST and waits for the plan and the\n"
-      "trajectory. Writes under --out: plan.json (acyclic.plan/1), trajectory.json\n"
+      "Runs the Acyclic pipeline on one machine: lcm-logger, acyclic-guide (for a scenario without key\n"
+      "postures), acyclic-planner and acyclic-interpolator (each with --lcm), then sends the scenario as\n"
+      "one ACYCLIC_REQUEST and waits for the plan and the trajectory. Writes under --out: plan.json (acyclic.plan/1), trajectory.json\n"
       "(acyclic.trajectory/1), run.lcmlog (every message of the run) and one log per process.\n"
       "A process that dies is restarted (3 times at most) and given again the work it lost.\n"
       "Everything started is stopped on exit and on Ctrl-C.\n"
@@ -129,7 +129,8 @@ int main(int argc, char** argv) {
   proc::installSignalHandlers();
 
   Supervisor sup([](const std::string& s) { say(s); });
-  std::vector<std::string> stages = {"acyclic-planner"};
+  // The guide author serves scenarios without key postures (it ignores the others).
+  std::vector<std::string> stages = {"acyclic-guide", "acyclic-planner"};
   if (!no_interpolate) stages.push_back("acyclic-interpolator");
   int rc = 1;
   try {
@@ -177,7 +178,9 @@ int main(int argc, char** argv) {
       bus.lcm().handleTimeout(50);
       for (const auto& name : sup.poll()) {
         ear.status_seen[name] = 0;  // wait for the new instance's first status
-        if (name == "acyclic-planner" && request_sent && !ear.plan) request_sent = false;   // send again
+        // The request again: the planner lost it. (A guide author that dies
+        // leaves the planner waiting; the planner then answers with the reason.)
+        if (name == "acyclic-planner" && request_sent && !ear.plan) request_sent = false;
         if (name == "acyclic-interpolator" && ear.plan && !ear.trajectory) lost_work_plan = true;
       }
       if (elapsed() > timeout_s) {

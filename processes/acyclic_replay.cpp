@@ -129,7 +129,8 @@ int main(int argc, char** argv) {
     bus.lcm().subscribe(channels::kTrajectory, &Ear::onTrajectory, &ear);
     Supervisor sup([](const std::string& s) { say(s); });
     const bool interpolate = !trajectories.empty();
-    for (const char* name : {"acyclic-planner", "acyclic-interpolator"}) {
+    // The guide author serves logged requests whose scenario has no key postures.
+    for (const char* name : {"acyclic-guide", "acyclic-planner", "acyclic-interpolator"}) {
       if (std::string(name) == "acyclic-interpolator" && !interpolate) continue;
       ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--lcm"}, ""};
       if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
@@ -146,7 +147,7 @@ int main(int argc, char** argv) {
         sup.poll();
       }
     };
-    waitFor([&] { return ear.status_seen["acyclic-planner"] > 0 &&
+    waitFor([&] { return ear.status_seen["acyclic-planner"] > 0 && ear.status_seen["acyclic-guide"] > 0 &&
                          (!interpolate || ear.status_seen["acyclic-interpolator"] > 0); },
             "status from the fresh processes");
     for (const auto& req : requests) {

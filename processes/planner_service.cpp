@@ -1,9 +1,12 @@
 #include "processes/planner_service.h"
 
 #include <cstdio>
+#include <map>
 #include <memory>
+#include <optional>
 
 #include "acyclic/cancel_t.hpp"
+#include "acyclic/guide_t.hpp"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/progress_t.hpp"
 #include "acyclic/request_t.hpp"
@@ -51,11 +54,20 @@ class PlannerService {
   PlannerService(proc::Bus& bus, PlannerOverrides o) : bus_(bus), status_(bus, kProcess), overrides_(o) {
     bus.lcm().subscribe(channels::kRequest, &PlannerService::onRequest, this);
     bus.lcm().subscribe(channels::kCancel, &PlannerService::onCancel, this);
+    bus.lcm().subscribe(channels::kGuide, &PlannerService::onGuide, this);
     status_.ready();
   }
   void tick() {
     worker_.reap();
     status_.tick();
+    if (waiting_ && proc::nowMicros() - waiting_->since_us > kGuideTimeoutUs) {
+      const request_t req = waiting_->req;
+      waiting_.reset();
+      refuse(req, plan_t::NO_SOLUTION,
+             "no ACYCLIC_GUIDE arrived within " + std::to_string(kGuideTimeoutUs / 1000000) +
+                 " s for a scenario without key postures (is acyclic-guide running?)");
+      status_.idle();
+    }
   }
   void stop() {
     if (worker_.busy()) proc::log(kProcess, "stopping: cancelling request " + std::to_string(worker_.current()));
@@ -79,9 +91,11 @@ class PlannerService {
   void onRequest(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     request_t req;
     if (!proc::decode(rb, channel, req, status_)) return;
-    if (worker_.busy()) {
+    if (worker_.busy() || waiting_) {
       refuse(req, plan_t::ERROR,
-             "refused: busy with request " + std::to_string(worker_.current()) + " (one request at a time)");
+             "refused: busy with request " +
+                 std::to_string(worker_.busy() ? worker_.current() : waiting_->req.request_id) +
+                 " (one request at a time)");
       return;
     }
     auto sc = std::make_shared<Scenario>();
@@ -96,6 +110,57 @@ class PlannerService {
       refuse(req, plan_t::INVALID_INPUT, std::string("the scenario does not load: ") + e.what());
       return;
     }
+    if (sc->key_postures.size() < 2 && params.guide_potential) {
+      // No hand-written guide: the guide process authors one (ACYCLIC_GUIDE).
+      status_.busy(req.request_id);
+      const auto g = guides_.find(req.request_id);
+      if (g != guides_.end()) {
+        useGuide(req, sc, params, g->second);
+      } else {
+        proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + sc->name +
+                                " has no key postures: waiting for its ACYCLIC_GUIDE");
+        waiting_ = Waiting{req, sc, params, proc::nowMicros()};
+      }
+      return;
+    }
+    startPlanning(req, sc, params);
+  }
+
+  void useGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params,
+                const guide_t& g) {
+    if (g.status != guide_t::OK) {
+      refuse(req, plan_t::NO_SOLUTION, "no guide: " + g.reason);
+      status_.idle();
+      return;
+    }
+    try {
+      for (const auto& m : g.postures)
+        sc->key_postures.push_back(convert::fromMessage(m, *sc, "ACYCLIC_GUIDE (request " +
+                                                                    std::to_string(req.request_id) + ")"));
+    } catch (const std::exception& e) {
+      refuse(req, plan_t::INVALID_INPUT, std::string("the guide cannot be read: ") + e.what());
+      status_.idle();
+      return;
+    }
+    proc::log(kProcess, "request " + std::to_string(req.request_id) + ": guide of " +
+                            std::to_string(g.num_postures) + " key postures (" + g.source + ")");
+    startPlanning(req, sc, params);
+  }
+
+  void onGuide(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    guide_t g;
+    if (!proc::decode(rb, channel, g, status_)) return;
+    if (waiting_ && waiting_->req.request_id == g.request_id) {
+      const Waiting w = *waiting_;
+      waiting_.reset();
+      useGuide(w.req, w.sc, w.params, g);
+      return;
+    }
+    guides_[g.request_id] = g;  // it may come before its request
+    while (guides_.size() > 16) guides_.erase(guides_.begin());
+  }
+
+  void startPlanning(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params) {
     proc::log(kProcess, "request " + std::to_string(req.request_id) + ": planning " + sc->name);
     status_.busy(req.request_id);
     worker_.start(req.request_id, [this, req, sc, params](const std::atomic<bool>& cancel) {
@@ -160,16 +225,33 @@ class PlannerService {
   void onCancel(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     cancel_t c;
     if (!proc::decode(rb, channel, c, status_)) return;
+    if (waiting_ && (c.request_id == -1 || c.request_id == waiting_->req.request_id)) {
+      const request_t req = waiting_->req;
+      waiting_.reset();
+      refuse(req, plan_t::CANCELLED, "cancelled while waiting for its guide");
+      status_.idle();
+      return;
+    }
     if (worker_.cancel(c.request_id))
       proc::log(kProcess, "request " + std::to_string(worker_.current()) + ": cancelled (" + c.reason + ")");
     else
       status_.error(c.request_id, "cancel: request " + std::to_string(c.request_id) + " is not running");
   }
 
+  struct Waiting {
+    request_t req;
+    std::shared_ptr<Scenario> sc;
+    PlannerParameters params;
+    std::int64_t since_us;
+  };
+  static constexpr std::int64_t kGuideTimeoutUs = 60'000'000;
+
   proc::Bus& bus_;
   proc::StatusReporter status_;
   PlannerOverrides overrides_;
   proc::Worker worker_;
+  std::optional<Waiting> waiting_;            // a request waiting for its guide
+  std::map<std::int64_t, guide_t> guides_;    // guides received before their request
 };
 
 }  // namespace

@@ -145,6 +145,8 @@ TEST(Pipeline, CorruptMessagesAndBadScenariosGetStatusErrorsAndTheProcessStaysUp
   p.start("acyclic-planner");
   if (haveInterpolator()) p.start("acyclic-interpolator");
   ASSERT_TRUE(c.waitFor([&] { return c.sawStatus("acyclic-planner", process_status_t::IDLE); }, 20));
+  if (haveInterpolator())
+    ASSERT_TRUE(c.waitFor([&] { return c.sawStatus("acyclic-interpolator", process_status_t::IDLE); }, 20));
 
   const char garbage[] = "not an LCM message";
   c.bus.publishRaw(channels::kRequest, garbage, sizeof garbage);
@@ -283,4 +285,23 @@ TEST(Pipeline, ProcessesExitCleanlyOnSigintAndSigtermEvenMidRequest) {
       EXPECT_EQ(waitExit(pid, 5), 0) << name << " after signal " << sig;
       EXPECT_TRUE(c.waitFor([&] { return c.sawStatus(name, process_status_t::STOPPING); }, 2)) << name;
     }
+}
+
+TEST(Pipeline, AScenarioWithoutKeyPosturesIsGuidedByTheOmplAuthor) {
+  REQUIRE_NETNS();
+  test::TempDir dir;
+  // step_forward without its key postures: the guide process authors them.
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  text = text.substr(0, text.find("key_postures:"));
+  const std::string scenario = dir.write("step_no_keys.yaml", text);
+  const auto run = test::runProcess(exe("acyclic-launch") + " -q --scenario " + scenario + " --out " + dir.path() +
+                                    "/run");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const auto check = test::runProcess(exe("acyclic-check") + " " + scenario + " --plan " + dir.path() + "/run/plan.json");
+  EXPECT_EQ(check.status, 0) << check.output;
+  lcm::LogFile log(dir.path() + "/run/run.lcmlog", "r");
+  ASSERT_TRUE(log.good());
+  int guides = 0;
+  for (const lcm::LogEvent* e; (e = log.readNextEvent());) guides += e->channel == channels::kGuide;
+  EXPECT_EQ(guides, 1);
 }
