@@ -1,0 +1,68 @@
+// The OMPL guide author: its time on each scenario (median over seeds), then
+// each scenario planned with the hand-written key postures and with the OMPL
+// guide only, side by side in one run: wall time, nodes, plan length.
+// Usage: bench_guide [SCENARIO...] [--seeds N] [--max-seconds T]
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "planner/guide/guide_author.h"
+#include "planner/search/planner_parameters.h"
+
+using namespace acyclic;
+
+int main(int argc, char** argv) {
+  std::vector<std::string> paths;
+  int seeds = 5;
+  double max_seconds = -1;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
+    else paths.push_back(argv[i]);
+  }
+  if (paths.empty())
+    paths = {ACYCLIC_SOURCE_DIR "/models/scenarios/step_forward.yaml",
+             ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml"};
+  std::printf("%-14s %-18s %12s %12s %8s\n", "scenario", "guide", "median s", "max s", "keys");
+  std::vector<Guide> guides;
+  for (const auto& path : paths) {
+    const Scenario sc = Scenario::load(path);
+    std::vector<double> t;
+    GuideResult first;
+    for (int s = 1; s <= seeds; ++s) {
+      GuideOptions o;
+      o.seed = static_cast<unsigned>(s);
+      const GuideResult r = authorGuide(sc, o);
+      if (s == static_cast<int>(sc.seed) || s == 1) first = r;
+      t.push_back(r.success() ? r.guide.seconds : r.goal_seconds + r.path_seconds);
+      if (!r.success()) std::printf("  seed %d: %s: %s\n", s, toString(r.status), r.reason.c_str());
+    }
+    std::sort(t.begin(), t.end());
+    std::printf("%-14s %-18s %12.3f %12.3f %8zu\n", sc.name.c_str(), toString(first.status), t[t.size() / 2],
+                t.back(), first.guide.key_postures.size());
+    guides.push_back(first.guide);
+  }
+  std::printf("\n%-14s %-12s %-22s %9s %7s %9s %8s\n", "scenario", "guide", "result", "seconds", "nodes", "calls",
+              "stances");
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const Scenario base = Scenario::load(paths[i]);
+    for (const bool ompl : {false, true}) {
+      Scenario sc = base;
+      if (ompl) sc.key_postures = guides[i].key_postures;
+      if (sc.key_postures.size() < 2) {
+        std::printf("%-14s %-12s %-22s\n", sc.name.c_str(), ompl ? "OMPL" : "hand", "no key postures");
+        continue;
+      }
+      PlannerParameters p = plannerParameters(sc);
+      if (max_seconds > 0) p.max_seconds = max_seconds;
+      const PlanningResult r = ContactPlanner(sc, p).plan();
+      std::printf("%-14s %-12s %-22s %9.2f %7ld %9ld %8zu\n", sc.name.c_str(), ompl ? "OMPL" : "hand",
+                  toString(r.status), r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls,
+                  r.plan.stances.size());
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
