@@ -181,13 +181,9 @@ int main(int argc, char** argv) {
   // while) so that the loop keeps its period; at most one is current.
   std::list<std::pair<std::thread, std::shared_ptr<std::atomic<bool>>>> checks;
   auto submit = [&](std::int64_t id, Trajectory tr) {
-    std::string why;
     {
       std::lock_guard<std::mutex> lock(mutex);
-      if (!bridge.beginCheck(id, hrp2::monotonicMicros(), &why)) {
-        status.error(id, why);
-        return;
-      }
+      if (!bridge.beginCheck(id, hrp2::monotonicMicros())) return;  // reported by the loop (a refusal event)
     }
     auto done = std::make_shared<std::atomic<bool>>(false);
     checks.emplace_back(std::thread([&, id, done, tr = std::move(tr)] {
@@ -327,7 +323,8 @@ int main(int argc, char** argv) {
     }
     if (cmd) bus->publish(channels::kHrp2Command, toMessage(*cmd));
     for (const hrp2::BridgeEvent& e : events) {
-      if (e.safety) status.error(st.request_id, e.text);
+      // Safety events and refusals: ACYCLIC_STATUS errors (and a log line); the rest: the log.
+      if (e.safety || e.refused) status.error(e.request_id >= 0 ? e.request_id : st.request_id, e.text);
       else proc::log(kName, e.text);
       if (file_mode && e.request_id == file_request_id) {
         file_done |= e.done;
