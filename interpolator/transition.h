@@ -6,22 +6,28 @@
 // Kinds, from consecutive kept stances a -> b:
 //   Fixed  the same contacts, or one contact's support flipped: every contact
 //          held, the supporting ones those supporting in either stance; knots
-//          at n steps, cost the distance to the linear interpolation of the
-//          two witnesses. No motion at all when the witnesses coincide.
+//          at one step per fixed_step of change (n at most), cost the distance
+//          to the linear interpolation of the two witnesses. No motion at all
+//          when the witnesses coincide.
 //   Move   a contact removed, added, or removed and then added again for the
 //          same spot (a -> b -> c merged, the settled stance b giving the
 //          contacts held in the air): the moving body follows a BodyPath from
 //          its pose in the first witness to its pose in the last; at n steps
-//          the posture generator holds the shared contacts and the body on its
-//          path. The body leaves (reaches) a surface in a short piece that
-//          keeps the contact: the phase changes when it is `touch_clearance`
-//          off the surface, where no check can mistake it for a collision.
+//          (and the spline's two ends) the posture generator holds the shared
+//          contacts and the body on its path, cost the distance to the
+//          witnesses' interpolation plus the distance to the previous step.
+//          A body that cannot follow the path exactly near a surface (a thigh
+//          whose foot is planted) pivots: height held, straight_slack across.
+//          The body leaves (reaches) a surface in a short piece that keeps the
+//          contact: the phase changes when it is `touch_clearance` off the
+//          surface, where no check can mistake it for a collision.
 // Between knots, the linear interpolation is checked at each segment's middle
 // by the independent validity check and refined where it fails; then every
 // sample the time law makes of the piece is checked the same way, and the
-// segment of a failing sample refined (so every output sample is valid). A Move whose
-// path collides (a knot infeasible, or a middle that refinement cannot fix) is
-// repaired by raising a via-point, higher on each attempt.
+// segment of a failing sample refined (so every output sample is valid). A
+// Move whose path collides (a knot infeasible, or a segment that refinement
+// cannot fix) is repaired by raising its spline into a bridge, higher on each
+// attempt.
 #include <atomic>
 #include <memory>
 #include <optional>
