@@ -117,10 +117,16 @@ int main(int argc, char** argv) {
                  "permitted the bridge says so and runs at normal priority)")
       ->check(CLI::Range(0, 99));
   app.add_option("--cpu", cpu, "run on this CPU only (default: any); e.g. the one the planner does not use");
+  bool lcm_flag = false;
+  app.add_flag("--lcm", lcm_flag, "accepted for symmetry with the other processes (LCM mode is the default without --trajectory)");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   CLI11_PARSE(app, argc, argv);
 
   const bool file_mode = !trajectory_path.empty();
+  if (file_mode && lcm_flag) {
+    std::fprintf(stderr, "%s: --lcm and --trajectory exclude each other\n", kName);
+    return 2;
+  }
   hrp2::BridgeConfig cfg;
   Scenario sc;
   Trajectory file_trajectory;

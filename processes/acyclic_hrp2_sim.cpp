@@ -80,6 +80,8 @@ int main(int argc, char** argv) {
                  "SCHED_FIFO priority of the control loop and LCM receive threads, 0: none (default 20; when not\n"
                  "permitted the simulator says so and runs at normal priority)")
       ->check(CLI::Range(0, 99));
+  bool lcm_flag = false;
+  app.add_flag("--lcm", lcm_flag, "accepted for symmetry with the other processes (the simulator always serves LCM)");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   CLI11_PARSE(app, argc, argv);
   o.servo_on = !servo_off;
