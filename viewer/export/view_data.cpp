@@ -92,7 +92,7 @@ json postureJson(const Scenario& sc, const ViewPosture& v) {
   }
   return {{"t", r5(v.t)}, {"stance", v.stance}, {"phase", v.phase}, {"sample", v.sample},
           {"poses", poses}, {"com", vec(v.com)}, {"contacts", contacts},
-          {"feasible", v.feasible}, {"margin", r5(v.margin)}, {"worst_torque_ratio", r5(v.worst_torque_ratio)}};
+          {"forces_from", v.forces_from_check ? "check" : "plan"}, {"feasible", v.feasible}, {"margin", r5(v.margin)}, {"worst_torque_ratio", r5(v.worst_torque_ratio)}};
 }
 
 }  // namespace
@@ -113,12 +113,23 @@ std::vector<ViewPosture> stancePostures(const Scenario& sc, const Plan& plan) {
     const PlanStance& s = plan.stances[i];
     ViewPosture v = evaluate(sc, kin, shapes, s.configuration, s.specs());
     v.stance = static_cast<int>(i);
-    // The plan's own forces: what the planner claims holds the robot.
+    // The plan's own forces: what the planner claims holds the robot. A plan
+    // written without them (e.g. by hand) gets the independent check's.
+    const QuasiStaticReport r = statics.check(kin, s.specs());
+    applyStatics(r, v);
+    bool plan_forces = true;
+    for (const auto& c : s.contacts) plan_forces &= !c.spec.supporting || !c.forces.empty();
+    v.forces_from_check = !plan_forces;
+    std::size_t k = 0;
     for (std::size_t c = 0; c < s.contacts.size(); ++c) {
-      v.contacts[c].points = s.contacts[c].points;
-      v.contacts[c].forces = s.contacts[c].forces;
+      if (plan_forces) {
+        v.contacts[c].points = s.contacts[c].points;
+        v.contacts[c].forces = s.contacts[c].forces;
+      } else if (s.contacts[c].spec.supporting) {
+        if (r.feasible && k < r.points.size()) v.contacts[c].points = r.points[k], v.contacts[c].forces = r.forces[k];
+        ++k;
+      }
     }
-    applyStatics(statics.check(kin, s.specs()), v);
     out.push_back(std::move(v));
   }
   return out;
@@ -148,6 +159,7 @@ std::vector<ViewPosture> trajectoryFrames(const Scenario& sc, const Trajectory& 
     v.sample = idx;
     v.phase = s.phase;
     v.stance = ph.stance;
+    v.forces_from_check = true;
     // The trajectory carries no forces: the independent check's (LP 2) are
     // shown, in the stance order of the supporting contacts.
     const QuasiStaticReport r = statics.check(kin, ph.contacts);

@@ -35,6 +35,7 @@ struct ViewPosture {
   std::vector<ViewContact> contacts;
   // The independent quasi-static check (planner/check/quasi_static.h) at this
   // posture with its supporting contacts: the friction margin (N) of LP 1.
+  bool forces_from_check = false;  // the forces shown are the check's (LP 2), not the plan's
   bool feasible = false;
   double margin = 0;
   double worst_torque_ratio = 0;

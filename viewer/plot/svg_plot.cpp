@@ -61,8 +61,12 @@ void panelSvg(std::ostringstream& o, const PlotPanel& p, double ox, double oy, d
   for (const auto& l : p.lines) yr.add(l.y);
   xr.finish();
   yr.finish();
-  const auto xt = niceTicks(xr.lo, xr.hi), yt = niceTicks(yr.lo, yr.hi);
-  const double x0 = std::min(xr.lo, xt.front()), x1 = std::max(xr.hi, xt.back());
+  // x spans the data exactly (time axes); y is widened to its outer ticks.
+  std::vector<double> xt;
+  for (double v : niceTicks(xr.lo, xr.hi))
+    if (v >= xr.lo - 1e-9 * (xr.hi - xr.lo) && v <= xr.hi + 1e-9 * (xr.hi - xr.lo)) xt.push_back(v);
+  const auto yt = niceTicks(yr.lo, yr.hi);
+  const double x0 = xr.lo, x1 = xr.hi;
   const double y0 = std::min(yr.lo, yt.front()), y1 = std::max(yr.hi, yt.back());
   auto X = [&](double v) { return left + (v - x0) / (x1 - x0) * (right - left); };
   auto Y = [&](double v) { return bottom - (v - y0) / (y1 - y0) * (bottom - top); };
@@ -70,7 +74,7 @@ void panelSvg(std::ostringstream& o, const PlotPanel& p, double ox, double oy, d
     << esc(p.title) << "</text>\n";
   o << "<rect x='" << num(left) << "' y='" << num(top) << "' width='" << num(right - left) << "' height='" << num(bottom - top)
     << "' fill='white' stroke='#888'/>\n";
-  const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1;
+  const double xstep = xt.size() > 1 ? xt[1] - xt[0] : (x1 - x0), ystep = yt.size() > 1 ? yt[1] - yt[0] : 1;
   for (double v : xt) {
     o << "<line x1='" << num(X(v)) << "' x2='" << num(X(v)) << "' y1='" << num(top) << "' y2='" << num(bottom)
       << "' stroke='#eee'/><text x='" << num(X(v)) << "' y='" << num(bottom + 12)

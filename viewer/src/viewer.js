@@ -210,7 +210,12 @@ function main() {
     if (!big) box.expandByPoint(new THREE.Vector3(o.pose[0], o.pose[1], o.pose[2]));
   }
   box.expandByPoint(new THREE.Vector3(box.min.x, box.min.y, 0));
-  const viewDir = new THREE.Vector3(1.25, -1.0, 0.55).normalize(); // front-right, from above
+  // From the robot's right, a little in front and above (x forward, z up):
+  // sideways the chair, the table and a step show in profile. ?view=x,y,z
+  // sets another direction (from the target towards the camera).
+  const viewParam = (params.get('view') || '').split(',').map(Number);
+  const viewDir = (viewParam.length === 3 && viewParam.every(Number.isFinite) && viewParam.some((v) => v !== 0)
+    ? new THREE.Vector3(viewParam[0], viewParam[1], viewParam[2]) : new THREE.Vector3(0.1, -1.0, 0.4)).normalize();
   // A camera along viewDir that fits a box: its vertical extent against the
   // vertical field of view, its horizontal extent against the horizontal one.
   function makeCamera(aspect, b) {
@@ -289,7 +294,8 @@ function main() {
     const p = data.stances[i];
     showPosture(p);
     state.current = { mode: 'stance', index: i, stance: i, t: null };
-    const title = 'stance ' + (i + 1) + ' of ' + data.stances.length + ' (plan forces)';
+    const title = 'stance ' + (i + 1) + ' of ' + data.stances.length +
+      (p.forces_from === 'plan' ? ' (plan forces)' : ' (forces: independent check)');
     label.textContent = title;
     describe(p, title);
     // The timeline follows: the first frame of this stance's phases.
@@ -320,6 +326,24 @@ function main() {
     let i = 0;
     while (i + 1 < data.frames.length && data.frames[i + 1].t <= t + 1e-9) ++i;
     return setFrame(i);
+  }
+
+  // What stance i changes from the one before (the paper's figure 5 captions);
+  // the first stance lists its contacts.
+  function stanceChange(i) {
+    const key = (c) => c.spot + '@' + c.surface;
+    const cur = data.stances[i].contacts;
+    if (i === 0) return cur.map((c) => c.spot + (c.supporting ? '' : ' (touching)')).join(', ');
+    const prev = new Map(data.stances[i - 1].contacts.map((c) => [key(c), c]));
+    const now = new Map(cur.map((c) => [key(c), c]));
+    const out = [];
+    for (const c of cur) {
+      const p = prev.get(key(c));
+      if (!p) out.push('+' + key(c) + (c.supporting ? '' : ' (touching)'));
+      else if (p.supporting !== c.supporting) out.push(c.spot + (c.supporting ? ' supports' : ' stops supporting'));
+    }
+    for (const c of data.stances[i - 1].contacts) if (!now.has(key(c))) out.push('-' + c.spot);
+    return out.join(', ') || 'no change';
   }
 
   let playStart = 0, playFrom = 0;
@@ -382,8 +406,8 @@ function main() {
       const cap = document.createElement('div');
       cap.className = 'caption';
       cap.style.left = 'calc(' + (k * cw) + '% + 6px)';
-      cap.textContent = 'stance ' + (si + 1) + ': ' + data.stances[si].contacts
-        .map((c) => c.spot + (c.supporting ? '' : ' (touching)')).join(', ');
+      cap.textContent = 'stance ' + (si + 1) + ': ' + stanceChange(si);
+      cap.style.maxWidth = 'calc(' + cw + '% - 24px)';
       document.body.appendChild(cap);
       captions.push(cap);
     });

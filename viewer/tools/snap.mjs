@@ -3,10 +3,11 @@
 // (window.acyclicViewer) as JSON on stdout, and saves a screenshot.
 //
 //   node viewer/tools/snap.mjs PAGE_DIR [--query 'stance=3&hud=0'] [--png OUT.png]
-//        [--width 1200] [--height 800] [--visit-stances]
+//        [--width 1200] [--height 800] [--visit-stances] [--state OUT.json]
 //
 // --visit-stances: calls setStance(i) for every stance and setFrame(i) for
-// every frame and reports what each drew (for tests).
+// every frame and reports what each drew (for tests). --state: the JSON goes
+// to that file instead of stdout.
 // Exit: 0 loaded, 1 the page reported an error or did not load, 2 bad usage
 // or no browser (CHROMIUM names it; default /usr/bin/chromium).
 import fs from 'node:fs';
@@ -19,7 +20,7 @@ function usage(msg) {
   process.exit(2);
 }
 const args = process.argv.slice(2);
-const opt = { query: '', png: null, width: 1200, height: 800, visit: false };
+const opt = { query: '', png: null, width: 1200, height: 800, visit: false, state: null };
 let dir = null;
 for (let i = 0; i < args.length; ++i) {
   const a = args[i];
@@ -29,6 +30,7 @@ for (let i = 0; i < args.length; ++i) {
   else if (a === '--width') opt.width = Number(next());
   else if (a === '--height') opt.height = Number(next());
   else if (a === '--visit-stances') opt.visit = true;
+  else if (a === '--state') opt.state = next();
   else if (a === '--help' || a === '-h') {
     console.log(fs.readFileSync(new URL(import.meta.url), 'utf8').split('\n').filter((l) => l.startsWith('//')).join('\n'));
     process.exit(0);
@@ -88,7 +90,9 @@ try {
     return out;
   });
   if (opt.png) await page.screenshot({ path: opt.png });
-  console.log(JSON.stringify({ url, state: st, visits, remote_requests: remote, console: logs }, null, 1));
+  const report = JSON.stringify({ url, state: st, visits, remote_requests: remote, console: logs }, null, 1);
+  if (opt.state) fs.writeFileSync(opt.state, report + '\n');
+  else console.log(report);
   if (st.error || !st.loaded || remote.length) code = 1;
   if (st.error) console.error('snap: the page reports: ' + st.error);
   if (remote.length) console.error('snap: the page asked the network for ' + remote.join(', '));
