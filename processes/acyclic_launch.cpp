@@ -16,6 +16,7 @@
 #include <optional>
 #include <sstream>
 
+#include "acyclic/hrp2_bridge_status_t.hpp"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/process_status_t.hpp"
 #include "acyclic/progress_t.hpp"
@@ -43,6 +44,7 @@ struct Listener {
   std::map<std::string, int> status_seen;  // process -> status messages since (re)start
   std::optional<plan_t> plan;
   std::optional<trajectory_t> trajectory;
+  std::optional<hrp2_bridge_status_t> played;   // the bridge's last status about our request
   bool tty = false;
 
   void onStatus(const lcm::ReceiveBuffer* rb, const std::string&, const process_status_t* m) {
@@ -62,6 +64,13 @@ struct Listener {
   }
   void onTrajectory(const lcm::ReceiveBuffer*, const std::string&, const trajectory_t* m) {
     if (m->request_id == request_id) trajectory = *m;
+  }
+  void onBridge(const lcm::ReceiveBuffer*, const std::string&, const hrp2_bridge_status_t* m) {
+    if (m->request_id != request_id) return;
+    played = *m;
+    if (tty && m->state == hrp2_bridge_status_t::STREAMING)
+      std::fprintf(stderr, "\racyclic-hrp2-bridge: streaming %5.1f %%  commands %ld  worst tracking error %.4f rad   ",
+                   100 * m->progress, static_cast<long>(m->commands_sent), m->tracking_error_max);
   }
 };
 
@@ -85,7 +94,9 @@ int main(int argc, char** argv) {
       "Runs the Acyclic pipeline on one machine: lcm-logger, acyclic-guide (for a scenario without key\n"
       "postures), acyclic-planner and acyclic-interpolator (each with --lcm), then sends the scenario as\n"
       "one ACYCLIC_REQUEST and waits for the plan and the trajectory. Writes under --out: plan.json (acyclic.plan/1), trajectory.json\n"
-      "(acyclic.trajectory/1), run.lcmlog (every message of the run) and one log per process.\n"
+      "(acyclic.trajectory/1), run.lcmlog (every message of the run) and one log per process; then plays\n"
+      "the trajectory through acyclic-hrp2-bridge on acyclic-hrp2-sim (the simulated controller) and\n"
+      "reports the tracking error and any safety event (--no-execute: stop at the trajectory).\n"
       "A process that dies is restarted (3 times at most) and given again the work it lost.\n"
       "Everything started is stopped on exit and on Ctrl-C.\n"
       "Exit status: 0 every stage answered OK, 1 a stage failed or timed out, 2 bad input.\n"
@@ -96,7 +107,7 @@ int main(int argc, char** argv) {
   long seed = -1;
   double budget_s = -1;
   std::int64_t request_id = 1;
-  bool no_interpolate = false, quiet = false, external = false;
+  bool no_interpolate = false, quiet = false, external = false, no_execute = false;
   std::vector<std::string> planner_args;
   app.add_option("--scenario", scenario_path, "scenario file (acyclic.scenario/1)")->required();
   app.add_option("--out", out_dir, "output folder (created)")->capture_default_str();
@@ -107,6 +118,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", budget_s, "planning budget sent with the request (default: the scenario's)");
   app.add_option("--request-id", request_id, "id of the request")->capture_default_str();
   app.add_flag("--no-interpolate", no_interpolate, "stop after the plan");
+  app.add_flag("--no-execute", no_execute,
+               "stop after the trajectory (default: play it through acyclic-hrp2-bridge on acyclic-hrp2-sim)");
   app.add_flag("--external", external,
                "use pipeline processes already running (on this or other machines): start only lcm-logger");
   app.add_option("--planner-arg", planner_args, "extra argument for acyclic-planner (repeatable)");
@@ -132,6 +145,9 @@ int main(int argc, char** argv) {
   // The guide author serves scenarios without key postures (it ignores the others).
   std::vector<std::string> stages = {"acyclic-guide", "acyclic-planner"};
   if (!no_interpolate) stages.push_back("acyclic-interpolator");
+  // Execution: the HRP-2 bridge and the simulated controller, when built.
+  const bool execute = !no_interpolate && !no_execute && fs::exists(fs::path(bin_dir) / "acyclic-hrp2-bridge") &&
+                       fs::exists(fs::path(bin_dir) / "acyclic-hrp2-sim");
   int rc = 1;
   try {
     proc::Bus bus(url);
@@ -142,6 +158,7 @@ int main(int argc, char** argv) {
     bus.lcm().subscribe(channels::kProgress, &Listener::onProgress, &ear);
     bus.lcm().subscribe(channels::kPlan, &Listener::onPlan, &ear);
     bus.lcm().subscribe(channels::kTrajectory, &Listener::onTrajectory, &ear);
+    bus.lcm().subscribe(channels::kHrp2BridgeStatus, &Listener::onBridge, &ear);
 
     // The logger first, so that the log holds the whole run.
     const std::string log_path = (fs::path(out_dir) / "run.lcmlog").string();
@@ -156,6 +173,14 @@ int main(int argc, char** argv) {
       if (name == "acyclic-planner") c.argv.insert(c.argv.end(), planner_args.begin(), planner_args.end());
       sup.start(c);
     }
+
+    if (execute && !external)
+      for (const char* name : {"acyclic-hrp2-sim", "acyclic-hrp2-bridge"}) {
+        ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--scenario", fs::absolute(scenario_path).string()},
+                    (fs::path(out_dir) / (std::string(name) + ".log")).string()};
+        if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
+        sup.start(c);
+      }
 
     request_t req{};
     req.request_id = request_id;
@@ -173,7 +198,8 @@ int main(int argc, char** argv) {
       return true;
     };
     bool request_sent = false, plan_sent_on = false, failed = false, done = false;
-    bool lost_work_plan = false;
+    bool lost_work_plan = false, trajectory_written = false;
+    double play_deadline = 0;
     while (!proc::stopRequested() && !done && !failed) {
       bus.lcm().handleTimeout(50);
       for (const auto& name : sup.poll()) {
@@ -181,7 +207,7 @@ int main(int argc, char** argv) {
         // The request again: the planner lost it. (A guide author that dies
         // leaves the planner waiting; the planner then answers with the reason.)
         if (name == "acyclic-planner" && request_sent && !ear.plan) request_sent = false;
-        if (name == "acyclic-interpolator" && ear.plan && !ear.trajectory) lost_work_plan = true;
+        if (name == "acyclic-interpolator" && ear.plan && !ear.trajectory && !trajectory_written) lost_work_plan = true;
       }
       if (elapsed() > timeout_s) {
         say("timed out after " + std::to_string(static_cast<int>(timeout_s)) + " s");
@@ -239,7 +265,34 @@ int main(int argc, char** argv) {
         writeTrajectory(tr, sc, tr_path);
         say("wrote " + tr_path + " (" + std::to_string(m.num_samples) + " samples, " +
             std::to_string(tr.duration()) + " s of motion)");
-        done = true;
+        if (!execute) {
+          done = true;
+        } else {
+          say("playing it on the simulated controller (acyclic-hrp2-bridge -> acyclic-hrp2-sim)");
+          play_deadline = elapsed() + tr.duration() + 60;
+        }
+        ear.trajectory.reset();
+        trajectory_written = true;
+      }
+      if (trajectory_written && execute && ear.played) {
+        const hrp2_bridge_status_t& b = *ear.played;
+        const bool finished = b.reason.rfind("done: request " + std::to_string(request_id) + " ", 0) == 0;
+        // Holding (a watchdog fired), a fault, an e-stop or a refusal ends the demo run: the bridge
+        // keeps the robot safe and waits for an operator, which a launcher is not.
+        const bool broken = b.state == hrp2_bridge_status_t::FAULT || b.state == hrp2_bridge_status_t::STOPPED ||
+                            b.state == hrp2_bridge_status_t::HOLDING || b.reason.rfind("refused", 0) == 0;
+        if (finished || broken) {
+          if (ear.tty) std::fprintf(stderr, "\n");
+          say(std::string("execution ") + (finished ? "done" : "FAILED") + ": " + b.reason + "; " +
+              std::to_string(b.commands_sent) + " commands, worst tracking error " +
+              std::to_string(b.tracking_error_max) + " rad, " + std::to_string(b.safety_events) + " safety events");
+          if (finished) done = true;
+          else failed = true;
+        }
+      }
+      if (trajectory_written && execute && elapsed() > play_deadline) {
+        say("execution: the bridge did not report the end of the motion in time (see acyclic-hrp2-bridge.log)");
+        failed = true;
       }
     }
     if (proc::stopRequested()) say("interrupted: stopping every process");

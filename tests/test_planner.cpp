@@ -43,6 +43,18 @@ TEST(ContactPlanner, SmallScenarioIsSolvedWithAValidPlan) {
     if (c.spec.supporting) {
       EXPECT_EQ(c.forces.size(), 4u);
     }
+  // Every contact's placement is its witness's spot frame, angle included
+  // (the contact rows fix the in-plane angle only modulo pi).
+  Kinematics kin(sc.robot);
+  for (const auto& st : r.plan.stances) {
+    kin.setConfiguration(st.configuration);
+    for (const auto& c : st.contacts) {
+      const ContactSpot& spot = sc.robot->spots()[c.spec.spot];
+      const Eigen::Isometry3d f = kin.linkPose(spot.link) * spot.frame;
+      const Eigen::Isometry3d g = contactFrame(sc.scene->surfaces()[c.spec.surface], c.spec.placement);
+      EXPECT_LT((f.linear().col(0) - g.linear().col(0)).norm(), 0.02) << sc.describe(c.spec);
+    }
+  }
 }
 
 TEST(ContactPlanner, SameScenarioAndSeedSamePlanWhateverTheThreads) {

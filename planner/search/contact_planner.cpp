@@ -366,7 +366,18 @@ struct ContactPlanner::Impl {
     const PairGenerator& g = gens[gi];
     traceCall("add " + sc.robot->spots()[g.spot].name + "@" + sc.scene->surfaces()[g.surface].name, res);
     if (!res.success()) return -1;  // that volume (or sample) holds no feasible contact
-    if (p.optimized_candidates) cand.added.placement = res.floating;
+    if (p.optimized_candidates) {
+      cand.added.placement = res.floating;
+      // The contact rows fix the in-plane angle modulo pi: the placement
+      // takes the witness's actual angle, so that the plan's contact frames
+      // are the witness's spot frames. (The search volume keeps the solver's
+      // angle: its parts are cut around it.)
+      kin.setConfiguration(res.configuration);
+      const ContactSpot& spot = sc.robot->spots()[g.spot];
+      const Eigen::Vector3d x = sc.scene->surfaces()[g.surface].frame.linear().transpose() *
+                                (kin.linkPose(spot.link).linear() * spot.frame.linear().col(0));
+      cand.added.placement.theta = std::atan2(x.y(), x.x());
+    }
     Node son;
     son.transition = nodes[g.node].contacts;
     son.transition.push_back(cand.added);
