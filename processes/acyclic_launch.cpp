@@ -109,6 +109,9 @@ int main(int argc, char** argv) {
   std::int64_t request_id = 1;
   bool no_interpolate = false, quiet = false, external = false, no_execute = false;
   std::vector<std::string> planner_args;
+  // Against the simulator on a shared machine, the bridge's watchdogs get the
+  // simulator's configuration (hrp2_bridge/config/simulated.yaml says why).
+  std::string bridge_config = ACYCLIC_SOURCE_DIR "/hrp2_bridge/config/simulated.yaml";
   app.add_option("--scenario", scenario_path, "scenario file (acyclic.scenario/1)")->required();
   app.add_option("--out", out_dir, "output folder (created)")->capture_default_str();
   app.add_option("--lcm-url", url, "LCM URL for every process (default: $LCM_DEFAULT_URL, else LCM's default)");
@@ -122,6 +125,8 @@ int main(int argc, char** argv) {
                "stop after the trajectory (default: play it through acyclic-hrp2-bridge on acyclic-hrp2-sim)");
   app.add_flag("--external", external,
                "use pipeline processes already running (on this or other machines): start only lcm-logger");
+  app.add_option("--bridge-config", bridge_config, "acyclic-hrp2-bridge's configuration (acyclic.hrp2_bridge/1)")
+      ->capture_default_str();
   app.add_option("--planner-arg", planner_args, "extra argument for acyclic-planner (repeatable)");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
@@ -179,6 +184,8 @@ int main(int argc, char** argv) {
         ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--scenario", fs::absolute(scenario_path).string()},
                     (fs::path(out_dir) / (std::string(name) + ".log")).string()};
         if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
+        if (std::string(name) == "acyclic-hrp2-bridge" && !bridge_config.empty())
+          c.argv.insert(c.argv.end(), {"--config", bridge_config});
         sup.start(c);
       }
 
