@@ -1,8 +1,5 @@
 #include "planner/plan/guide.h"
 
-#include <cstdio>
-#include <fstream>
-#include <sstream>
 
 #include "planner/plan/json_field.h"
 
@@ -24,33 +21,16 @@ std::string guideToJson(const Guide& g, const Scenario& sc) {
 }
 
 void writeGuide(const Guide& g, const Scenario& sc, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-    out << guideToJson(g, sc) << "\n";
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot rename " + tmp + " to " + path);
+  json_field::writeFileAtomically(path, guideToJson(g, sc) + "\n");
 }
 
 Guide readGuide(const std::string& path, const Scenario& sc) {
-  std::ifstream in(path);
-  if (!in) throw FormatError(path, "", "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return guideFromJson(ss.str(), path, sc);
+  return guideFromJson(json_field::readWholeFile(path), path, sc);
 }
 
 Guide guideFromJson(const std::string& text, const std::string& origin, const Scenario& sc) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw FormatError(origin, "", std::string("not valid JSON: ") + e.what());
-  }
+  const json doc = json_field::parseFormat(text, origin, "acyclic.guide/1");
   const J root{doc, origin, ""};
-  if (root.at("format").string() != "acyclic.guide/1") root.at("format").fail("'acyclic.guide/1'");
   json_field::checkJointNames(root.at("joint_names"), sc);
   Guide g;
   g.scenario = root.has("scenario") ? root.at("scenario").string() : "";

@@ -60,6 +60,12 @@ struct J {
 
 
 // The pieces the formats share (defined in plan.cpp).
+// Writes text to path beside, then renames: a crash never leaves half a file.
+void writeFileAtomically(const std::string& path, const std::string& text);
+// A file's text; FormatError naming it when it cannot be read.
+std::string readWholeFile(const std::string& path);
+// Parses JSON and checks its "format" field; FormatError naming origin otherwise.
+json parseFormat(const std::string& text, const std::string& origin, const std::string& format);
 json specToJson(const ContactSpec& c, const Scenario& sc);          // spot, surface, supporting, x, y, theta
 ContactSpec specFromJson(const J& j, const Scenario& sc);
 json configurationToJson(const Configuration& q);                  // base_position, base_orientation, joints

@@ -62,6 +62,37 @@ Configuration configurationFromJson(const J& jq, const Scenario& sc) {
   return q;
 }
 
+void writeFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot rename " + tmp + " to " + path);
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FormatError(path, "", "cannot open the file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+json parseFormat(const std::string& text, const std::string& origin, const std::string& format) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw FormatError(origin, "", std::string("not valid JSON: ") + e.what());
+  }
+  const J root{doc, origin, ""};
+  if (root.at("format").string() != format) root.at("format").fail("'" + format + "'");
+  return doc;
+}
+
 void checkJointNames(const J& names, const Scenario& sc) {
   if (names.size() != static_cast<std::size_t>(sc.robot->numJoints()))
     names.fail("the robot's " + std::to_string(sc.robot->numJoints()) + " joint names");
@@ -106,34 +137,16 @@ std::string planToJson(const Plan& plan, const Scenario& sc) {
 }
 
 void writePlan(const Plan& plan, const Scenario& sc, const std::string& path) {
-  // Write beside, then rename: a crash never leaves half a plan.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-    out << planToJson(plan, sc) << "\n";
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot rename " + tmp + " to " + path);
+  json_field::writeFileAtomically(path, planToJson(plan, sc) + "\n");
 }
 
 Plan readPlan(const std::string& path, const Scenario& sc) {
-  std::ifstream in(path);
-  if (!in) throw FormatError(path, "", "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return planFromJson(ss.str(), path, sc);
+  return planFromJson(json_field::readWholeFile(path), path, sc);
 }
 
 Plan planFromJson(const std::string& text, const std::string& origin, const Scenario& sc) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw FormatError(origin, "", std::string("not valid JSON: ") + e.what());
-  }
+  const json doc = json_field::parseFormat(text, origin, "acyclic.plan/1");
   const J root{doc, origin, ""};
-  if (root.at("format").string() != "acyclic.plan/1") root.at("format").fail("'acyclic.plan/1'");
   Plan plan;
   plan.scenario = root.has("scenario") ? root.at("scenario").string() : "";
   plan.robot = root.has("robot") ? root.at("robot").string() : "";

@@ -1,9 +1,6 @@
 #include "planner/plan/trajectory.h"
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <sstream>
 
 #include "planner/plan/json_field.h"
 
@@ -46,22 +43,11 @@ std::string trajectoryToJson(const Trajectory& tr, const Scenario& sc) {
 }
 
 void writeTrajectory(const Trajectory& tr, const Scenario& sc, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-    out << trajectoryToJson(tr, sc) << "\n";
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot rename " + tmp + " to " + path);
+  json_field::writeFileAtomically(path, trajectoryToJson(tr, sc) + "\n");
 }
 
 Trajectory readTrajectory(const std::string& path, const Scenario& sc) {
-  std::ifstream in(path);
-  if (!in) throw FormatError(path, "", "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return trajectoryFromJson(ss.str(), path, sc);
+  return trajectoryFromJson(json_field::readWholeFile(path), path, sc);
 }
 
 namespace {
@@ -75,14 +61,8 @@ double finite(const J& j) {
 }  // namespace
 
 Trajectory trajectoryFromJson(const std::string& text, const std::string& origin, const Scenario& sc) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw FormatError(origin, "", std::string("not valid JSON: ") + e.what());
-  }
+  const json doc = json_field::parseFormat(text, origin, "acyclic.trajectory/1");
   const J root{doc, origin, ""};
-  if (root.at("format").string() != "acyclic.trajectory/1") root.at("format").fail("'acyclic.trajectory/1'");
   Trajectory tr;
   tr.scenario = root.has("scenario") ? root.at("scenario").string() : "";
   tr.plan = root.has("plan") ? root.at("plan").string() : "";
