@@ -74,6 +74,14 @@ void applyStatics(const QuasiStaticReport& r, ViewPosture& v) {
   v.worst_torque_ratio = r.worst_torque_ratio;
 }
 
+// The check's corners and forces of stance contact c (the report holds one
+// list per stance contact, empty for those that do not support).
+void takeCheckForces(const QuasiStaticReport& r, std::size_t c, ViewContact& vc) {
+  if (!r.feasible || !vc.supporting || c >= r.points.size()) return;
+  vc.points = r.points[c];
+  vc.forces = r.forces[c];
+}
+
 json postureJson(const Scenario& sc, const ViewPosture& v) {
   json poses = json::array();
   for (const auto& T : v.shape_poses) appendPose(poses, T);
@@ -120,14 +128,12 @@ std::vector<ViewPosture> stancePostures(const Scenario& sc, const Plan& plan) {
     bool plan_forces = true;
     for (const auto& c : s.contacts) plan_forces &= !c.spec.supporting || !c.forces.empty();
     v.forces_from_check = !plan_forces;
-    std::size_t k = 0;
     for (std::size_t c = 0; c < s.contacts.size(); ++c) {
       if (plan_forces) {
         v.contacts[c].points = s.contacts[c].points;
         v.contacts[c].forces = s.contacts[c].forces;
-      } else if (s.contacts[c].spec.supporting) {
-        if (r.feasible && k < r.points.size()) v.contacts[c].points = r.points[k], v.contacts[c].forces = r.forces[k];
-        ++k;
+      } else {
+        takeCheckForces(r, c, v.contacts[c]);
       }
     }
     out.push_back(std::move(v));
@@ -160,16 +166,10 @@ std::vector<ViewPosture> trajectoryFrames(const Scenario& sc, const Trajectory& 
     v.phase = s.phase;
     v.stance = ph.stance;
     v.forces_from_check = true;
-    // The trajectory carries no forces: the independent check's (LP 2) are
-    // shown, in the stance order of the supporting contacts.
+    // The trajectory carries no forces: the independent check's (LP 2) are shown.
     const QuasiStaticReport r = statics.check(kin, ph.contacts);
     applyStatics(r, v);
-    std::size_t k = 0;
-    for (auto& c : v.contacts) {
-      if (!c.supporting) continue;
-      if (r.feasible && k < r.points.size()) c.points = r.points[k], c.forces = r.forces[k];
-      ++k;
-    }
+    for (std::size_t c = 0; c < v.contacts.size(); ++c) takeCheckForces(r, c, v.contacts[c]);
     out.push_back(std::move(v));
   }
   return out;
