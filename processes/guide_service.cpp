@@ -26,20 +26,12 @@ int8_t guideStatus(GuideResult::Status s) {
   return guide_t::ERROR;
 }
 
-class GuideService {
+class GuideService : public proc::Service {
  public:
-  GuideService(proc::Bus& bus, GuideOptions o) : bus_(bus), status_(bus, kProcess), options_(o) {
+  GuideService(proc::Bus& bus, GuideOptions o) : proc::Service(bus, kProcess), options_(o) {
     bus.lcm().subscribe(channels::kRequest, &GuideService::onRequest, this);
     bus.lcm().subscribe(channels::kCancel, &GuideService::onCancel, this);
     status_.ready();
-  }
-  void tick() {
-    worker_.reap();
-    status_.tick();
-  }
-  void stop() {
-    worker_.stop();
-    status_.stopping();
   }
 
  private:
@@ -112,28 +104,13 @@ class GuideService {
     worker_.cancel(c.request_id);
   }
 
-  proc::Bus& bus_;
-  proc::StatusReporter status_;
   GuideOptions options_;
-  proc::Worker worker_;
 };
 
 }  // namespace
 
 int serveGuide(const std::string& lcm_url, const GuideOptions& options) {
-  try {
-    proc::Bus bus(lcm_url);
-    GuideService service(bus, options);
-    proc::log(kProcess, "serving " + std::string(channels::kRequest) + " on " +
-                            (lcm_url.empty() ? std::string("LCM's default URL") : lcm_url));
-    const int rc = proc::spin(bus, [&] { service.tick(); });
-    service.stop();
-    proc::log(kProcess, "stopped");
-    return rc;
-  } catch (const std::exception& e) {
-    proc::log(kProcess, std::string("fatal: ") + e.what());
-    return 1;
-  }
+  return proc::serve<GuideService>(lcm_url, kProcess, channels::kRequest, options);
 }
 
 }  // namespace acyclic

@@ -27,20 +27,12 @@ int8_t trajectoryStatus(InterpolationResult::Status s) {
   return trajectory_t::ERROR;
 }
 
-class InterpolatorService {
+class InterpolatorService : public proc::Service {
  public:
-  InterpolatorService(proc::Bus& bus, InterpolatorOptions o) : bus_(bus), status_(bus, kProcess), options_(o) {
+  InterpolatorService(proc::Bus& bus, InterpolatorOptions o) : proc::Service(bus, kProcess), options_(o) {
     bus.lcm().subscribe(channels::kPlan, &InterpolatorService::onPlan, this);
     bus.lcm().subscribe(channels::kCancel, &InterpolatorService::onCancel, this);
     status_.ready();
-  }
-  void tick() {
-    worker_.reap();
-    status_.tick();
-  }
-  void stop() {
-    worker_.stop();
-    status_.stopping();
   }
 
  private:
@@ -126,28 +118,13 @@ class InterpolatorService {
       proc::log(kProcess, "request " + std::to_string(worker_.current()) + ": cancelled (" + c.reason + ")");
   }
 
-  proc::Bus& bus_;
-  proc::StatusReporter status_;
   InterpolatorOptions options_;
-  proc::Worker worker_;
 };
 
 }  // namespace
 
 int serveInterpolator(const std::string& lcm_url, const InterpolatorOptions& options) {
-  try {
-    proc::Bus bus(lcm_url);
-    InterpolatorService service(bus, options);
-    proc::log(kProcess, "serving " + std::string(channels::kPlan) + " on " +
-                            (lcm_url.empty() ? std::string("LCM's default URL") : lcm_url));
-    const int rc = proc::spin(bus, [&] { service.tick(); });
-    service.stop();
-    proc::log(kProcess, "stopped");
-    return rc;
-  } catch (const std::exception& e) {
-    proc::log(kProcess, std::string("fatal: ") + e.what());
-    return 1;
-  }
+  return proc::serve<InterpolatorService>(lcm_url, kProcess, channels::kPlan, options);
 }
 
 }  // namespace acyclic

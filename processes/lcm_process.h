@@ -113,4 +113,43 @@ int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<boo
 // Logs "process: message" to stderr with a timestamp (the process's log).
 void log(const std::string& process, const std::string& message);
 
+// What a request-serving process holds: the bus, its status, one worker.
+// tick() is called by the loop, stop() on SIGINT/SIGTERM.
+class Service {
+ public:
+  Service(Bus& bus, const std::string& process) : bus_(bus), status_(bus, process) {}
+  virtual ~Service() = default;
+  virtual void tick() {
+    worker_.reap();
+    status_.tick();
+  }
+  virtual void stop() {
+    worker_.stop();
+    status_.stopping();
+  }
+
+ protected:
+  Bus& bus_;
+  StatusReporter status_;
+  Worker worker_;
+};
+
+// Runs a Service (constructed from the bus and the options) until a signal:
+// the LCM loop, the log lines, the exit status (0, or 1 when LCM fails).
+template <class S, class Options>
+int serve(const std::string& url, const std::string& process, const std::string& serving, const Options& options) {
+  try {
+    Bus bus(url);
+    S service(bus, options);
+    log(process, "serving " + serving + " on " + (url.empty() ? std::string("LCM's default URL") : url));
+    const int rc = spin(bus, [&] { service.tick(); });
+    service.stop();
+    log(process, "stopped");
+    return rc;
+  } catch (const std::exception& e) {
+    log(process, std::string("fatal: ") + e.what());
+    return 1;
+  }
+}
+
 }  // namespace acyclic::proc

@@ -49,17 +49,16 @@ int8_t planStatus(PlanningResult::Status s) {
   return plan_t::ERROR;
 }
 
-class PlannerService {
+class PlannerService : public proc::Service {
  public:
-  PlannerService(proc::Bus& bus, PlannerOverrides o) : bus_(bus), status_(bus, kProcess), overrides_(o) {
+  PlannerService(proc::Bus& bus, PlannerOverrides o) : proc::Service(bus, kProcess), overrides_(o) {
     bus.lcm().subscribe(channels::kRequest, &PlannerService::onRequest, this);
     bus.lcm().subscribe(channels::kCancel, &PlannerService::onCancel, this);
     bus.lcm().subscribe(channels::kGuide, &PlannerService::onGuide, this);
     status_.ready();
   }
-  void tick() {
-    worker_.reap();
-    status_.tick();
+  void tick() override {
+    proc::Service::tick();
     if (waiting_ && proc::nowMicros() - waiting_->since_us > kGuideTimeoutUs) {
       const request_t req = waiting_->req;
       waiting_.reset();
@@ -69,10 +68,9 @@ class PlannerService {
       status_.idle();
     }
   }
-  void stop() {
+  void stop() override {
     if (worker_.busy()) proc::log(kProcess, "stopping: cancelling request " + std::to_string(worker_.current()));
-    worker_.stop();
-    status_.stopping();
+    proc::Service::stop();
   }
 
  private:
@@ -246,10 +244,7 @@ class PlannerService {
   };
   static constexpr std::int64_t kGuideTimeoutUs = 60'000'000;
 
-  proc::Bus& bus_;
-  proc::StatusReporter status_;
   PlannerOverrides overrides_;
-  proc::Worker worker_;
   std::optional<Waiting> waiting_;            // a request waiting for its guide
   std::map<std::int64_t, guide_t> guides_;    // guides received before their request
 };
@@ -257,19 +252,7 @@ class PlannerService {
 }  // namespace
 
 int servePlanner(const std::string& lcm_url, const PlannerOverrides& overrides) {
-  try {
-    proc::Bus bus(lcm_url);
-    PlannerService service(bus, overrides);
-    proc::log(kProcess, "serving " + std::string(channels::kRequest) + " on " +
-                            (lcm_url.empty() ? std::string("LCM's default URL") : lcm_url));
-    const int rc = proc::spin(bus, [&] { service.tick(); });
-    service.stop();
-    proc::log(kProcess, "stopped");
-    return rc;
-  } catch (const std::exception& e) {
-    proc::log(kProcess, std::string("fatal: ") + e.what());
-    return 1;
-  }
+  return proc::serve<PlannerService>(lcm_url, kProcess, channels::kRequest, overrides);
 }
 
 }  // namespace acyclic

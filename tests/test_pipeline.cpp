@@ -145,8 +145,9 @@ TEST(Pipeline, CorruptMessagesAndBadScenariosGetStatusErrorsAndTheProcessStaysUp
   p.start("acyclic-planner");
   if (haveInterpolator()) p.start("acyclic-interpolator");
   ASSERT_TRUE(c.waitFor([&] { return c.sawStatus("acyclic-planner", process_status_t::IDLE); }, 20));
-  if (haveInterpolator())
+  if (haveInterpolator()) {
     ASSERT_TRUE(c.waitFor([&] { return c.sawStatus("acyclic-interpolator", process_status_t::IDLE); }, 20));
+  }
 
   const char garbage[] = "not an LCM message";
   c.bus.publishRaw(channels::kRequest, garbage, sizeof garbage);
