@@ -283,6 +283,11 @@ TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
     EXPECT_GT(v.at("drawn").at("arrows").get<int>(), 0) << "stance " << i;
     EXPECT_EQ(v.at("drawn").at("com").get<int>(), 1);
   }
+  // Play moves the timeline (by wall time; a slow machine moves it less, never not at all).
+  const auto& play = j.at("visits").at("play");
+  EXPECT_TRUE(play.at("playing").get<bool>());
+  EXPECT_EQ(play.at("mode"), "frame");
+  EXPECT_GT(play.at("t").get<double>(), 0.0);
   const auto frames = trajectoryFrames(sc_, tr_, 25);
   const auto& fv = j.at("visits").at("frames");
   ASSERT_EQ(fv.size(), frames.size());

@@ -71,13 +71,24 @@ try {
     { timeout: 60000 });
   let visits = null;
   if (opt.visit) {
-    visits = await page.evaluate(() => {
+    visits = await page.evaluate(async () => {
       const v = window.acyclicViewer;
       if (v.error) return null;
       const stances = [], frames = [];
       for (let i = 0; i < v.stances; ++i) { const c = v.setStance(i); stances.push({ current: c, drawn: v.drawn }); }
       for (let i = 0; i < v.frames; ++i) { const c = v.setFrame(i); frames.push({ current: c, drawn: v.drawn }); }
-      return { stances, frames };
+      // Play from the start: the timeline moves within 10 s of wall time (the
+      // renders queued by the visits above go first on a software renderer).
+      let play = null;
+      if (v.frames > 1) {
+        v.setFrame(0);
+        v.play();
+        const playing = v.playing;
+        for (let k = 0; k < 100 && !(v.current.t > 0); ++k) await new Promise((r) => setTimeout(r, 100));
+        play = { playing, t: v.current.t, mode: v.current.mode };
+        v.pause();
+      }
+      return { stances, frames, play };
     });
     // Back to what the query asked for, for the screenshot.
     await page.goto(url, { waitUntil: 'load' });
