@@ -48,7 +48,8 @@ const browser = await puppeteer.launch({
   executablePath: chromium,
   headless: true,
   // No GPU here: WebGL through SwiftShader (software), the same pixels on every machine.
-  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--disable-gpu-sandbox',
+  // --disable-dev-shm-usage: containers often have a tiny /dev/shm.
+  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--disable-gpu-sandbox', '--disable-dev-shm-usage',
     '--hide-scrollbars', '--mute-audio', '--font-render-hinting=none'],
   defaultViewport: { width: opt.width, height: opt.height, deviceScaleFactor: 1 },
 });
