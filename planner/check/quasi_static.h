@@ -29,7 +29,8 @@ struct QuasiStaticReport {
   std::string worst_joint;
   double residual = 0;              // |force and moment balance| / weight, at LP 2's forces
   int supporting_contacts = 0;
-  // Per supporting contact, in stance order: world corner points and forces (LP 2).
+  // Per stance contact, in stance order: world corner points and forces (LP 2);
+  // empty for a contact that does not support.
   std::vector<std::vector<Eigen::Vector3d>> points, forces;
 };
 
