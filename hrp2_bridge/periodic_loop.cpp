@@ -55,6 +55,15 @@ void setBackgroundPriority(bool realtime) {
   pthread_setschedparam(pthread_self(), realtime ? SCHED_FIFO : SCHED_OTHER, &p);
 }
 
+std::string enterRealtime(int priority) {
+  if (priority <= 0) return "normal priority";
+  std::string why;
+  if (!setRealtimePriority(priority, &why)) return "normal priority (SCHED_FIFO refused: " + why + ")";
+  // No page faults in the loop: everything mapped now and later stays in memory.
+  return "SCHED_FIFO " + std::to_string(priority) +
+         (lockMemory(&why) ? ", memory locked" : ", memory not locked (" + why + ")");
+}
+
 PeriodicLoop::PeriodicLoop(double period_s) : period_ns_(std::llround(period_s * 1e9)) {
   if (period_ns_ <= 0) throw std::invalid_argument("PeriodicLoop: the period must be positive");
   clock_gettime(CLOCK_MONOTONIC, &next_);

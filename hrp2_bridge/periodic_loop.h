@@ -25,6 +25,11 @@ bool pinToCpu(int cpu, std::string* why = nullptr);
 // in a real-time loop costs milliseconds. False (with the reason) when not permitted.
 bool lockMemory(std::string* why = nullptr);
 
+// setRealtimePriority then lockMemory when priority > 0, as a real-time
+// process starts; returns what it got, for the process's log ("SCHED_FIFO 20,
+// memory locked", or "normal priority (SCHED_FIFO refused: ...)").
+std::string enterRealtime(int priority);
+
 // For the heavy threads of a real-time process (checks, LPs): SCHED_FIFO 1,
 // below the loops, when `realtime`; else the normal time-sharing policy.
 // Not SCHED_OTHER in a real-time process: a time-shared thread preempted

@@ -150,7 +150,6 @@ int main(int argc, char** argv) {
   proc::installSignalHandlers();
   // Real time before LCM starts its threads, so that they inherit it; the
   // heavy threads (checks, trajectory intake) drop it.
-  std::string rt_note = "normal priority";
   if (cpu >= 0) {
     std::string why;
     if (!hrp2::pinToCpu(cpu, &why)) {
@@ -158,16 +157,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (rt_priority > 0) {
-    std::string why;
-    if (hrp2::setRealtimePriority(rt_priority, &why)) {
-      rt_note = "SCHED_FIFO " + std::to_string(rt_priority);
-      // No page faults in the loop: everything mapped now and later stays in memory.
-      rt_note += hrp2::lockMemory(&why) ? ", memory locked" : ", memory not locked (" + why + ")";
-    } else {
-      rt_note = "normal priority (SCHED_FIFO refused: " + why + ")";
-    }
-  }
+  const std::string rt_note = hrp2::enterRealtime(rt_priority);
   std::unique_ptr<proc::Bus> bus;
   try {
     bus = std::make_unique<proc::Bus>(url);

@@ -100,17 +100,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   proc::installSignalHandlers();
-  std::string rt_note = "normal priority";
-  if (rt_priority > 0) {
-    std::string why;
-    if (hrp2::setRealtimePriority(rt_priority, &why)) {
-      rt_note = "SCHED_FIFO " + std::to_string(rt_priority);
-      // No page faults in the loop: everything mapped now and later stays in memory.
-      rt_note += hrp2::lockMemory(&why) ? ", memory locked" : ", memory not locked (" + why + ")";
-    } else {
-      rt_note = "normal priority (SCHED_FIFO refused: " + why + ")";
-    }
-  }
+  const std::string rt_note = hrp2::enterRealtime(rt_priority);
   std::unique_ptr<proc::Bus> bus;
   try {
     bus = std::make_unique<proc::Bus>(url);

@@ -24,6 +24,7 @@
 #include "acyclic/trajectory_t.hpp"
 #include "lcmtypes/channels.hpp"
 #include "planner/common/format_error.h"
+#include "planner/plan/json_field.h"
 #include "processes/lcm_convert.h"
 #include "processes/lcm_process.h"
 #include "processes/supervisor.h"
@@ -74,27 +75,15 @@ struct Listener {
   }
 };
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string selfDir() {
-  std::error_code ec;
-  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string(".") : p.parent_path().string();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "Runs the Acyclic pipeline on one machine: lcm-logger, acyclic-guide (for a scenario without key\n"
       "postures), acyclic-planner and acyclic-interpolator (each with --lcm), then sends the scenario as\n"
-      "one ACYCLIC_REQUEST and waits for the plan and the trajectory. Writes under --out: plan.json (acyclic.plan/1), trajectory.json\n"
-      "(acyclic.trajectory/1), run.lcmlog (every message of the run) and one log per process; then plays\n"
+      "one ACYCLIC_REQUEST and waits for the plan and the trajectory. Writes under --out: plan.json\n"
+      "(acyclic.plan/1), trajectory.json (acyclic.trajectory/1), run.lcmlog (every message of the run)\n"
+      "and one log per process; then plays\n"
       "the trajectory through acyclic-hrp2-bridge on acyclic-hrp2-sim (the simulated controller) and\n"
       "reports the tracking error and any safety event (--no-execute: stop at the trajectory).\n"
       "A process that dies is restarted (3 times at most) and given again the work it lost.\n"
@@ -102,7 +91,7 @@ int main(int argc, char** argv) {
       "Exit status: 0 every stage answered OK, 1 a stage failed or timed out, 2 bad input.\n"
       "Multicast: run it inside a private network namespace (scripts/run-pipeline does) or on a lab\n"
       "network with ttl=1 (README, 'Across machines')."};
-  std::string scenario_path, out_dir = "acyclic-run", url = proc::defaultLcmUrl(), bin_dir = selfDir();
+  std::string scenario_path, out_dir = "acyclic-run", url = proc::defaultLcmUrl(), bin_dir = executableDir();
   double timeout_s = 900;
   long seed = -1;
   double budget_s = -1;
@@ -192,7 +181,7 @@ int main(int argc, char** argv) {
     request_t req{};
     req.request_id = request_id;
     req.scenario_name = sc.name;
-    req.scenario_yaml = readFile(scenario_path);
+    req.scenario_yaml = json_field::readWholeFile(scenario_path);
     req.base_path = fs::absolute(scenario_path).parent_path().string();
     req.seed = seed;
     req.time_budget_s = budget_s;

@@ -66,12 +66,6 @@ struct Ear {
   }
 };
 
-std::string selfDir() {
-  std::error_code ec;
-  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string(".") : p.parent_path().string();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,7 +74,7 @@ int main(int argc, char** argv) {
       "acyclic-planner and acyclic-interpolator processes and checks that their answers equal the logged\n"
       "ones (all but send times and wall-time figures). Exit status: 0 identical, 1 a difference or no\n"
       "answer, 2 bad input. Run it where LCM multicast works (scripts/netns-run)."};
-  std::string log_path, url = proc::defaultLcmUrl(), bin_dir = selfDir();
+  std::string log_path, url = proc::defaultLcmUrl(), bin_dir = executableDir();
   double timeout_s = 300;
   app.add_option("log", log_path, "LCM log file")->required();
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");

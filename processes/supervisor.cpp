@@ -7,12 +7,19 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <thread>
 
 namespace acyclic {
+
+std::string executableDir() {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : p.parent_path().string();
+}
 
 pid_t Supervisor::spawn(const ChildSpec& spec) {
   if (access(spec.argv.at(0).c_str(), X_OK) != 0)

@@ -10,6 +10,9 @@
 
 namespace acyclic {
 
+// The folder of the running executable (where its sibling executables are), "." if unknown.
+std::string executableDir();
+
 struct ChildSpec {
   std::string name;               // for logs
   std::vector<std::string> argv;  // argv[0] is the executable's path
