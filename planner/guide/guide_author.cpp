@@ -153,7 +153,7 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
       c.spot = spot;
       c.surface = floor;
       c.supporting = true;
-      c.placement = projectOnSurface(sc.scene->surfaces()[floor], kin.linkPose(m.spots()[spot].link) * m.spots()[spot].frame);
+      c.placement = projectOnSurface(sc.scene->surfaces()[floor], kin.spotPose(spot));
       r.contacts.push_back(c);
     }
     r.initial_guess = q;

@@ -81,6 +81,7 @@ struct ContactPlanner::Impl {
     int parent = -1;
     Change change = Change::Root;
     int generator = -1;                   // the pair generator that made it (lazy sons)
+    int depth = 0;                        // contact changes from the start (set by addNode)
   };
   struct PairGenerator {
     int node, spot, surface;
@@ -201,18 +202,12 @@ struct ContactPlanner::Impl {
     return distance <= reach + p.reach_slack;
   }
 
-  int depth(int ni) const {
-    int d = 0;
-    for (; nodes[ni].parent >= 0; ni = nodes[ni].parent) ++d;
-    return d;
-  }
-
   void traceExpansion(int ni) {
     if (!p.trace) return;
     const Node& n = nodes[ni];
     kin.setConfiguration(n.q);
     const Eigen::Vector3d w = kin.linkPose(sc.goal.link).translation();
-    std::string line = "expand #" + std::to_string(ni) + " depth " + std::to_string(depth(ni)) + " key " +
+    std::string line = "expand #" + std::to_string(ni) + " depth " + std::to_string(n.depth) + " key " +
                        std::to_string(n.key) + " goal link (" + std::to_string(w.x()).substr(0, 6) + ", " +
                        std::to_string(w.y()).substr(0, 6) + ", " + std::to_string(w.z()).substr(0, 6) + "):";
     char buf[64];
@@ -234,6 +229,7 @@ struct ContactPlanner::Impl {
       ++stats.check_refusals;
       return -1;
     }
+    n.depth = n.parent >= 0 ? nodes[n.parent].depth + 1 : 0;
     if (!key_given) n.key = keyOf(n.q);  // leaves kin at n.q
     else kin.setConfiguration(n.q);
     nodes.push_back(std::move(n));
@@ -241,7 +237,7 @@ struct ContactPlanner::Impl {
     if (sc.goal.satisfied(kin) && goal_node < 0) goal_node = id;
     // The open list's order: f_T, plus (when set) a cost per contact change
     // from the start, which lifts plateaus of equal f_T (weighted A*).
-    open.push({nodes[id].key + p.depth_weight * depth(id), order++, id});
+    open.push({nodes[id].key + p.depth_weight * nodes[id].depth, order++, id});
     if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) stats.best_potential = nodes[id].key;
     return id;
   }
@@ -251,11 +247,13 @@ struct ContactPlanner::Impl {
   // generator i % threads, so the results do not depend on timing.
   std::vector<PostureResult> solveAll(const std::vector<PostureRequest>& rs) {
     std::vector<PostureResult> out(rs.size());
+    std::vector<char> ran(rs.size(), 0);  // a cancellation leaves the rest unsolved (BadInput, never used)
     const std::size_t workers = std::min(pgs.size(), rs.size());
     auto run = [&](std::size_t w) {
       for (std::size_t i = w; i < rs.size(); i += workers) {
-        if (cancel && cancel->load()) break;  // left as BadInput: counted, never used
+        if (cancel && cancel->load()) break;
         out[i] = pgs[w]->solve(rs[i]);
+        ran[i] = 1;
       }
     };
     if (workers <= 1) {
@@ -266,10 +264,11 @@ struct ContactPlanner::Impl {
       run(0);
       for (auto& t : pool) t.join();
     }
-    for (const auto& r : out) {
-      ++stats.posture_calls;
-      if (!r.success()) ++stats.posture_failures;
-    }
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (ran[i]) {
+        ++stats.posture_calls;
+        if (!out[i].success()) ++stats.posture_failures;
+      }
     return out;
   }
 
@@ -366,17 +365,15 @@ struct ContactPlanner::Impl {
     const PairGenerator& g = gens[gi];
     traceCall("add " + sc.robot->spots()[g.spot].name + "@" + sc.scene->surfaces()[g.surface].name, res);
     if (!res.success()) return -1;  // that volume (or sample) holds no feasible contact
+    const double key = keyOf(res.configuration);  // leaves kin at the witness
     if (p.optimized_candidates) {
       cand.added.placement = res.floating;
       // The contact rows fix the in-plane angle modulo pi: the placement
       // takes the witness's actual angle, so that the plan's contact frames
       // are the witness's spot frames. (The search volume keeps the solver's
       // angle: its parts are cut around it.)
-      kin.setConfiguration(res.configuration);
-      const ContactSpot& spot = sc.robot->spots()[g.spot];
-      const Eigen::Vector3d x = sc.scene->surfaces()[g.surface].frame.linear().transpose() *
-                                (kin.linkPose(spot.link).linear() * spot.frame.linear().col(0));
-      cand.added.placement.theta = std::atan2(x.y(), x.x());
+      cand.added.placement.theta =
+          projectOnSurface(sc.scene->surfaces()[g.surface], kin.spotPose(g.spot)).theta;
     }
     Node son;
     son.transition = nodes[g.node].contacts;
@@ -387,7 +384,7 @@ struct ContactPlanner::Impl {
     son.parent = g.node;
     son.change = Change::Added;
     son.generator = gi;
-    son.key = keyOf(res.configuration);  // also orders the parts of its volume
+    son.key = key;  // also orders the parts of its volume
     if (p.optimized_candidates)
       for (auto& part : subtractBox(cand.volume, res.floating, p.box)) gens[gi].volumes.push_back({son.key, part});
     return addNode(son, true);
