@@ -12,6 +12,8 @@
 
 #include <Eigen/Core>
 
+#include "planner/common/format_error.h"
+
 namespace acyclic::test {
 
 inline std::string sourcePath(const std::string& rel) { return std::string(ACYCLIC_SOURCE_DIR) + "/" + rel; }
@@ -68,6 +70,24 @@ inline std::string scenarioText(const std::string& rel) {
   text.replace(text.find("../hrp2/"), 8, models + "hrp2/");
   text.replace(text.find("../scenes/"), 10, models + "scenes/");
   return text;
+}
+
+// Replaces `from` by `to` in a file's text and expects `parse(text)` to throw
+// a FormatError naming `file` and `field`.
+template <class Parse>
+void expectBadField(const Parse& parse, const std::string& text, const std::string& file, const std::string& from,
+                    const std::string& to, const std::string& field) {
+  std::string t = text;
+  const auto at = t.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  t.replace(at, from.size(), to);
+  try {
+    parse(t);
+    ADD_FAILURE() << "accepted a bad file (" << field << ")";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.field(), field) << e.what();
+    EXPECT_EQ(e.file(), file);
+  }
 }
 
 }  // namespace acyclic::test

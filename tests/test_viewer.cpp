@@ -145,7 +145,9 @@ TEST_F(Viewer, FramesAreTheTrajectorysOwnSamplesAtTheDisplayRate) {
     SCOPED_TRACE("frame " + std::to_string(k));
     ASSERT_GE(f.sample, 0);
     const TrajectorySample& s = tr_.samples[f.sample];
-    if (k < expected) EXPECT_LE(std::abs(s.t - k / fps), tr_.dt / 2 + 1e-9);  // the nearest sample
+    if (k < expected) {
+      EXPECT_LE(std::abs(s.t - k / fps), tr_.dt / 2 + 1e-9);  // the nearest sample
+    }
     EXPECT_EQ(f.t, s.t);
     EXPECT_TRUE(f.q.joints.isApprox(s.q.joints, 0.0));
     EXPECT_EQ(f.phase, s.phase);
