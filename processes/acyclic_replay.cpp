@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 #include "acyclic/plan_t.hpp"
@@ -36,15 +37,10 @@ void say(const std::string& s) {
 
 // A message's encoding with the fields that legitimately differ between two
 // runs (send time, wall-time figures) cleared.
-std::vector<char> canonical(plan_t m) {
+template <class Msg>
+std::vector<char> canonical(Msg m) {
   m.utime = 0;
-  m.seconds = 0;
-  std::vector<char> b(m.getEncodedSize());
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
-std::vector<char> canonical(trajectory_t m) {
-  m.utime = 0;
+  if constexpr (std::is_same_v<Msg, plan_t>) m.seconds = 0;
   std::vector<char> b(m.getEncodedSize());
   m.encode(b.data(), 0, static_cast<int>(b.size()));
   return b;
