@@ -19,12 +19,13 @@ int main(int argc, char** argv) {
   const Scenario sc = Scenario::load(path);
   struct Variant {
     const char* name;
-    bool lazy, optimized, guide;
+    bool lazy, optimized, guide, memory;
   };
-  const Variant variants[] = {{"full planner (lazy sons, optimized candidates, f_T)", true, true, true},
-                              {"eager sons", false, true, true},
-                              {"random candidates", true, false, true},
-                              {"distance to goal instead of f_T", true, true, false}};
+  const Variant variants[] = {{"full planner (lazy sons, optimized candidates, f_T)", true, true, true, true},
+                              {"no failure memory", true, true, true, false},
+                              {"eager sons", false, true, true, true},
+                              {"random candidates", true, false, true, true},
+                              {"distance to goal instead of f_T", true, true, false, true}};
   std::printf("scenario %s, budget per run: %s\n", sc.name.c_str(),
               max_seconds > 0 ? (std::to_string(max_seconds) + " s").c_str() : "the scenario's");
   std::printf("%-52s %-22s %9s %7s %9s %9s %8s\n", "variant", "result", "seconds", "nodes", "calls", "failed",
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
     p.lazy_sons = v.lazy;
     p.optimized_candidates = v.optimized;
     p.guide_potential = v.guide;
+    p.failure_memory = v.memory;
     const PlanningResult r = ContactPlanner(sc, p).plan();
     std::printf("%-52s %-22s %9.2f %7ld %9ld %9ld %8zu\n", v.name, toString(r.status), r.stats.seconds,
                 r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures, r.plan.stances.size());

@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
   app.add_flag("--random-candidates", o.random_candidates,
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");
   app.add_flag("--distance-to-goal", o.distance_to_goal, "ablation: distance to the goal instead of the guide potential");
+  app.add_flag("--no-failure-memory", o.no_failure_memory,
+               "ablation: try every pair at every node, even where it just failed from the same place");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   CLI11_PARSE(app, argc, argv);
@@ -83,9 +85,10 @@ int main(int argc, char** argv) {
     const acyclic::PlanningResult r = planner.plan(&acyclic::proc::stopFlag(), progress);
     if (tty) std::fprintf(stderr, "\n");
     const auto& s = r.stats;
-    std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated, %ld expanded, %ld posture calls (%ld failed)\n",
+    std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated, %ld expanded, %ld posture calls (%ld failed), "
+                "%ld pairs skipped by the failure memory\n",
                 sc.name.c_str(), acyclic::toString(r.status), s.seconds, s.nodes_generated, s.nodes_expanded,
-                s.posture_calls, s.posture_failures);
+                s.posture_calls, s.posture_failures, s.pairs_remembered);
     if (!r.solved()) {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
       return 1;

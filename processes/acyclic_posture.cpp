@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> remove;
   int iterations = 300;
   double seconds = 5;
+  int print_level = 0;
+  std::vector<std::string> ipopt;
   app.add_option("scenario", scenario_path, "scenario file (acyclic.scenario/1)")->required();
   app.add_option("--from", from,
                  "start from the last stance of this plan instead (its contacts all supporting, as the planner's "
@@ -37,6 +39,9 @@ int main(int argc, char** argv) {
   app.add_option("--add", add, "SPOT@SURFACE: a contact to add, floating over the surface");
   app.add_option("--iterations", iterations, "Ipopt iterations at most")->capture_default_str();
   app.add_option("--max-seconds", seconds, "CPU seconds at most")->capture_default_str();
+  app.add_option("--print-level", print_level, "Ipopt's print level (0-12), to see why a solve fails")
+      ->check(CLI::Range(0, 12));
+  app.add_option("--ipopt", ipopt, "a further Ipopt option NAME=VALUE (repeatable)");
   app.add_option("--out", out,
                  "write the witness as a one-stance plan (acyclic.plan/1) with the stance once the change settles "
                  "(removed contacts gone, the added one supporting): the input of a next --from");
@@ -73,6 +78,8 @@ int main(int argc, char** argv) {
     PostureGeneratorOptions o;
     o.max_iterations = iterations;
     o.max_seconds = seconds;
+    o.print_level = print_level;
+    o.ipopt_options = ipopt;
     PostureGenerator pg(sc.robot, sc.scene, o);
     const PostureResult res = pg.solve(r);
     std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s\n", toString(res.status), res.iterations,

@@ -28,6 +28,7 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   p.lazy_sons = !eager_sons;
   p.optimized_candidates = !random_candidates;
   p.guide_potential = !distance_to_goal;
+  if (no_failure_memory) p.failure_memory = false;
   if (verbose) p.trace = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   return p;
 }

@@ -83,19 +83,20 @@ TEST(Hrp2Check, AValidTrajectoryPasses) {
 
 TEST(Hrp2Check, TheValidityContractRefusesAMotionIntoTheTable) {
   // RARM_JOINT0 -0.4 rad from the seated start: clear of the table, valid
-  // (the independent check, sample by sample); -0.5 rad: the forearm touches it.
+  // (the independent check, sample by sample); -0.6 rad: the forearm goes
+  // into it (about 2 cm).
   BridgeConfig cfg;
   const PrepareResult ok = prepareChecked(synthetic(1.0, 16, -0.4), chair(), cfg);
   EXPECT_TRUE(ok.check.ok) << ok.check.reason;
   EXPECT_FALSE(ok.prepared.samples.empty());
-  const PrepareResult bad = prepareChecked(synthetic(1.5, 16, -0.5), chair(), cfg);
+  const PrepareResult bad = prepareChecked(synthetic(1.5, 16, -0.6), chair(), cfg);
   ASSERT_FALSE(bad.check.ok);
   EXPECT_NE(bad.check.reason.find("table_top"), std::string::npos) << bad.check.reason;
   EXPECT_TRUE(bad.prepared.samples.empty());
   // Within the robot's limits: only the contract sees it.
-  EXPECT_TRUE(prepareTrajectory(synthetic(1.5, 16, -0.5), chair().robot, chair().scene, cfg).check.ok);
+  EXPECT_TRUE(prepareTrajectory(synthetic(1.5, 16, -0.6), chair().robot, chair().scene, cfg).check.ok);
   cfg.check_contract = false;
-  EXPECT_TRUE(prepareChecked(synthetic(1.5, 16, -0.5), chair(), cfg).check.ok);
+  EXPECT_TRUE(prepareChecked(synthetic(1.5, 16, -0.6), chair(), cfg).check.ok);
 }
 
 TEST(Hrp2Check, NanIsRefusedNamingSampleAndJoint) {

@@ -441,7 +441,7 @@ TEST_F(Hrp2Processes, LatencyAndDroppedCommandsAreRiddenThrough) {
 
 TEST_F(Hrp2Processes, AMotionIntoTheTableIsRefusedByTheContractAndNothingMoves) {
   // Within every joint limit, but the forearm reaches the table top.
-  const std::string file = trajectoryFile(armMotion(1.5, -0.5), "into_table.json");
+  const std::string file = trajectoryFile(armMotion(1.5, -0.6), "into_table.json");
   Child& s = sim();
   Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file});
   EXPECT_EQ(wait(b, 20), 1) << logs();

@@ -30,6 +30,13 @@ const Scenario& chairScenario() {
   return sc;
 }
 
+// The chair scene as it was before its seat was lowered (seat at knee-pit
+// height, thigh spots mid-thigh), kept for the fixture plan made in it.
+const Scenario& kneePitChairScenario() {
+  static Scenario sc = Scenario::load(test::sourcePath("tests/data/chair_knee_pit.yaml"));
+  return sc;
+}
+
 PlanStance stance(const std::vector<ContactSpec>& contacts, const Configuration& q) {
   PlanStance s;
   for (const auto& c : contacts) {
@@ -366,11 +373,12 @@ TEST(Interpolator, CollidingStepIsRepairedByRaisingThePath) {
 }
 
 TEST(Interpolator, ThighPivotsOffTheSeatWithItsFootPlanted) {
-  // tests/data/chair_palm_thigh.plan.json: seated, the left palm reaches the
-  // table and takes weight, then the left thigh is unloaded and leaves the
-  // seat. A thigh whose foot stays planted cannot rise straight with its
-  // orientation held (its knee moves across the shank only): it pivots.
-  const Scenario& sc = chairScenario();
+  // tests/data/chair_palm_thigh.plan.json (in tests/data/chair_knee_pit.yaml):
+  // seated, the left palm reaches the table and takes weight, then the left
+  // thigh is unloaded and leaves the seat. A thigh whose foot stays planted
+  // cannot rise straight with its orientation held (its knee moves across the
+  // shank only): it pivots.
+  const Scenario& sc = kneePitChairScenario();
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_palm_thigh.plan.json"), sc);
   ASSERT_EQ(plan.stances.size(), 5u);
   InterpolatorOptions opt;

@@ -110,6 +110,28 @@ TEST(ContactPlanner, InvalidStartIsRefused) {
   EXPECT_NE(r.reason.find("start stance"), std::string::npos) << r.reason;
 }
 
+TEST(ContactPlanner, TheFailureMemorySkipsPairsThatJustFailedFromTheSamePlace) {
+  // The chair, 25 nodes: sons of the seated robot keep most spots where
+  // their parents held them, and a pair that failed there (a knee on the
+  // table) is not tried again. Without the memory every pair is tried at
+  // every node: more posture calls for the same number of nodes.
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));
+  PlannerParameters with = plannerParameters(sc), without = with;
+  with.max_nodes = without.max_nodes = 25;
+  without.failure_memory = false;
+  const PlanningResult a = ContactPlanner(sc, with).plan();
+  const PlanningResult b = ContactPlanner(sc, without).plan();
+  EXPECT_EQ(a.status, PlanningResult::Status::NodeBudget) << a.reason;
+  EXPECT_EQ(b.status, PlanningResult::Status::NodeBudget) << b.reason;
+  EXPECT_GT(a.stats.pairs_remembered, 0);
+  EXPECT_EQ(b.stats.pairs_remembered, 0);
+  EXPECT_LT(a.stats.posture_calls, b.stats.posture_calls);
+  // The memory is part of the search: still deterministic.
+  const PlanningResult c = ContactPlanner(sc, with).plan();
+  EXPECT_EQ(c.stats.posture_calls, a.stats.posture_calls);
+  EXPECT_EQ(c.stats.pairs_remembered, a.stats.pairs_remembered);
+}
+
 TEST(ContactPlanner, AblationsStillPlanValidly) {
   const Scenario& sc = step();
   for (int which = 0; which < 3; ++which) {

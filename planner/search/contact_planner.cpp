@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <algorithm>
 #include <deque>
 #include <cmath>
 #include <queue>
@@ -82,11 +83,13 @@ struct ContactPlanner::Impl {
     Change change = Change::Root;
     int generator = -1;                   // the pair generator that made it (lazy sons)
     int depth = 0;                        // contact changes from the start (set by addNode)
+    std::vector<std::pair<int, int>> failed_pairs;  // (spot, surface): first candidate failed here
   };
   struct PairGenerator {
     int node, spot, surface;
     std::vector<std::pair<double, SearchVolume>> volumes;  // inherited key, volume
     int samples_left = 0;
+    bool first = true;  // its next candidate is the first (the whole surface)
   };
   struct Entry {
     double key;
@@ -364,7 +367,12 @@ struct ContactPlanner::Impl {
   int acceptCandidate(int gi, Candidate& cand, const PostureResult& res) {
     const PairGenerator& g = gens[gi];
     traceCall("add " + sc.robot->spots()[g.spot].name + "@" + sc.scene->surfaces()[g.surface].name, res);
-    if (!res.success()) return -1;  // that volume (or sample) holds no feasible contact
+    const bool first = g.first;
+    gens[gi].first = false;
+    if (!res.success()) {  // that volume (or sample) holds no feasible contact
+      if (first && p.optimized_candidates) nodes[g.node].failed_pairs.push_back({g.spot, g.surface});
+      return -1;
+    }
     const double key = keyOf(res.configuration);  // leaves kin at the witness
     if (p.optimized_candidates) {
       cand.added.placement = res.floating;
@@ -400,6 +408,28 @@ struct ContactPlanner::Impl {
     return -1;
   }
 
+  // Whether the failure memory says pair (spot, surface) fails at node ni: its
+  // first candidate failed at ni's parent, and ni's witness holds the spot
+  // where the parent's did (within the duplicate tolerances). Remembered at
+  // ni too, for its own sons.
+  bool rememberedFailure(int ni, int spot, int surface) {
+    if (!p.failure_memory || !p.optimized_candidates) return false;
+    const int pi = nodes[ni].parent;
+    if (pi < 0) return false;
+    const auto& failed = nodes[pi].failed_pairs;
+    if (std::find(failed.begin(), failed.end(), std::make_pair(spot, surface)) == failed.end()) return false;
+    kin.setConfiguration(nodes[pi].q);
+    const Eigen::Isometry3d before = kin.spotPose(spot);
+    kin.setConfiguration(nodes[ni].q);
+    const Eigen::Isometry3d now = kin.spotPose(spot);
+    const double moved = (now.translation() - before.translation()).norm();
+    const double turned = Eigen::AngleAxisd(before.linear().transpose() * now.linear()).angle();
+    if (moved > p.duplicate_distance || turned > p.duplicate_angle) return false;
+    nodes[ni].failed_pairs.push_back({spot, surface});
+    ++stats.pairs_remembered;
+    return true;
+  }
+
   void expand(int ni) {
     ++stats.nodes_expanded;
     traceExpansion(ni);
@@ -411,6 +441,7 @@ struct ContactPlanner::Impl {
       for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
       if (used) continue;
       for (int surface : sc.allowed_surfaces) {
+        if (rememberedFailure(ni, spot, surface)) continue;
         kin.setConfiguration(nodes[ni].q);
         if (!reachable(spot, surface, kin)) continue;
         PairGenerator g;

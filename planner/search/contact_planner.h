@@ -44,6 +44,13 @@ struct PlannerParameters {
   int random_samples_per_pair = 4;     // with optimized_candidates = false
   int eager_candidates_per_pair = 6;   // with lazy_sons = false: candidates per pair at expansion
   bool guide_potential = true;         // paper 2.7 (false: distance to the goal)
+  // Failure memory (beyond the paper): a pair (spot, surface) whose first
+  // candidate, over the whole surface, failed at a node is not tried at a son
+  // of that node whose witness holds the spot within duplicate_distance and
+  // duplicate_angle of where it was: the same local problem from the same
+  // place fails again. Pairs that cannot be made from a posture (a knee on
+  // the table from a seat) otherwise cost a failed call at every node.
+  bool failure_memory = true;
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
   // Posture generators run at once on independent sons (removal sons, each
   // pair's first son). Results do not depend on it: request i of a batch
@@ -56,6 +63,7 @@ struct PlannerParameters {
 
 struct PlanningStats {
   long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
+  long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
   double seconds = 0, best_potential = 0;
 };
 
