@@ -410,7 +410,7 @@ struct ContactPlanner::Impl {
 
   // Whether the failure memory says pair (spot, surface) fails at node ni: its
   // first candidate failed at ni's parent, and ni's witness holds the spot
-  // where the parent's did (within the duplicate tolerances). Remembered at
+  // where the parent's did (within the failure memory's tolerances). Remembered at
   // ni too, for its own sons.
   bool rememberedFailure(int ni, int spot, int surface) {
     if (!p.failure_memory || !p.optimized_candidates) return false;
@@ -424,7 +424,7 @@ struct ContactPlanner::Impl {
     const Eigen::Isometry3d now = kin.spotPose(spot);
     const double moved = (now.translation() - before.translation()).norm();
     const double turned = Eigen::AngleAxisd(before.linear().transpose() * now.linear()).angle();
-    if (moved > p.duplicate_distance || turned > p.duplicate_angle) return false;
+    if (moved > p.failure_memory_distance || turned > p.failure_memory_angle) return false;
     nodes[ni].failed_pairs.push_back({spot, surface});
     ++stats.pairs_remembered;
     return true;

@@ -46,11 +46,13 @@ struct PlannerParameters {
   bool guide_potential = true;         // paper 2.7 (false: distance to the goal)
   // Failure memory (beyond the paper): a pair (spot, surface) whose first
   // candidate, over the whole surface, failed at a node is not tried at a son
-  // of that node whose witness holds the spot within duplicate_distance and
-  // duplicate_angle of where it was: the same local problem from the same
-  // place fails again. Pairs that cannot be made from a posture (a knee on
-  // the table from a seat) otherwise cost a failed call at every node.
+  // of that node whose witness holds the spot within failure_memory_distance
+  // and failure_memory_angle of where it was: the same local problem from the
+  // same place fails again. Pairs that cannot be made from a posture (a knee
+  // on the table from a seat) otherwise cost a failed call at every node.
   bool failure_memory = true;
+  double failure_memory_distance = 0.05;  // m
+  double failure_memory_angle = 0.35;     // rad
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
   // Posture generators run at once on independent sons (removal sons, each
   // pair's first son). Results do not depend on it: request i of a batch

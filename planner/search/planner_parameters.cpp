@@ -8,7 +8,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   const YamlField& f = *sc.planner_section;
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations",
-               "collision_margin"});
+               "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
     const double v = f[key].number();
@@ -31,6 +31,9 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   }
   positive("duplicate_distance", p.duplicate_distance);
   positive("duplicate_angle", p.duplicate_angle);
+  positive("failure_memory_distance", p.failure_memory_distance);
+  positive("failure_memory_angle", p.failure_memory_angle);
+  if (f.has("failure_memory")) p.failure_memory = f["failure_memory"].boolean();
   positive("max_seconds", p.max_seconds);
   positive("collision_margin", p.posture.problem.collision_margin);
   count("max_contacts", p.max_contacts);
