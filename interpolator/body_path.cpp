@@ -102,23 +102,32 @@ double BodyPath::arriveParameter(double clearance) const {
   return to_.normal && length() > 0 ? 1.0 - std::min(clearance, lift1_) / length() : 1.0;
 }
 
-BodyPath BodyPath::raised(double height) const {
+Eigen::Vector3d BodyPath::up() const {
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
   if (from_.normal) up += *from_.normal;
   if (to_.normal) up += *to_.normal;
   if (up.norm() < 1e-6) up = Eigen::Vector3d::UnitZ();
-  up.normalize();
+  return up.normalized();
+}
+
+Eigen::Vector3d BodyPath::viaPoint(double at, double height, double across) const {
+  const Eigen::Vector3d u = up(), a = points_.front(), b = points_.back();
+  const double top = std::max(a.dot(u), b.dot(u)) + height;
+  Eigen::Vector3d side = u.cross(b - a);
+  side = side.norm() > 1e-9 ? Eigen::Vector3d(side.normalized()) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d v = a + at * (b - a);
+  return v + (top - v.dot(u)) * u + across * side;
+}
+
+BodyPath BodyPath::detoured(double at, double across) const {
+  return BodyPath(from_, to_, lift_, {viaPoint(at, 0, across)});
+}
+
+BodyPath BodyPath::bridged(double height, double across) const {
   // A bridge: rise to `height` above the higher end of the spline by a third
   // of the way, cross at that height, come down over the last third. It
   // clears an obstacle between the ends, or an edge the lower end is below.
-  const Eigen::Vector3d a = points_.front(), b = points_.back();
-  const double top = std::max(a.dot(up), b.dot(up)) + height;
-  std::vector<Eigen::Vector3d> vias;
-  for (double f : {1.0 / 3, 2.0 / 3}) {
-    const Eigen::Vector3d v = a + f * (b - a);
-    vias.push_back(v + (top - v.dot(up)) * up);
-  }
-  return BodyPath(from_, to_, lift_, vias);
+  return BodyPath(from_, to_, lift_, {viaPoint(1.0 / 3, height, across), viaPoint(2.0 / 3, height, across)});
 }
 
 }  // namespace acyclic

@@ -37,11 +37,24 @@ class BodyPath {
   // `height` above the higher end of the spline (along the mean of the end
   // normals, or world z): a repair that raises the path away from what it
   // collides with.
-  BodyPath raised(double height) const;
+  BodyPath raised(double height) const { return bridged(height, 0); }
+  // The same bridge moved `across` sideways (across the chord, square to
+  // `up`; positive to the left of the chord seen from above): a detour
+  // around what the body would sweep through on its way, as a chair's leg
+  // beside a foot that steps past it, which no height clears.
+  BodyPath bridged(double height, double across) const;
+  // One via-point at fraction `at` of the way, at the higher end's height,
+  // `across` sideways (as bridged's): a detour that turns early or late, as a
+  // foot that must first step sideways past a post and then back.
+  BodyPath detoured(double at, double across) const;
   const std::vector<Eigen::Vector3d>& vias() const { return vias_; }
 
  private:
   Eigen::Vector3d curvePoint(double u) const;  // u in [0, number of spline segments]
+  // Along the mean of the end normals (or world z): where a repair raises the path.
+  Eigen::Vector3d up() const;
+  // A repair's via-point: at fraction `at` of the spline's chord, `height` above its higher end, `across` sideways.
+  Eigen::Vector3d viaPoint(double at, double height, double across) const;
   BodyPathEnd from_, to_;
   double lift_;
   double lift0_ = 0, lift1_ = 0;

@@ -26,7 +26,7 @@ struct InterpolatorOptions {
   double lift = 0.03;            // m: straight along the normal when leaving and reaching a surface
   double touch_clearance = 5e-4; // m: a body this far off its surface has left it
   double air_orientation_tolerance = 0.3;  // the moving body's orientation in the air (transition.h)
-  int repair_attempts = 4;       // raised via-points tried on a colliding path
+  int repair_attempts = 4;       // raised or sideways via-points tried on a colliding path
   double repair_step = 0.05;     // m: via-point height added per attempt
   int refine_depth = 3;
   // Check every output sample with the validity contract (and refine where

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <set>
 
 #include "interpolator/time_law.h"
 #include "planner/common/geometry.h"
+#include "planner/collision/collision_model.h"
 
 namespace acyclic {
 
@@ -40,6 +42,33 @@ std::string pair(int a, int b) { return "stances " + std::to_string(a) + " -> " 
 
 double distance(const Configuration& a, const Configuration& b) {
   return difference(a, b).cwiseAbs().maxCoeff();
+}
+
+// A shape at its world pose.
+using PlacedShape = std::pair<const CollisionShape*, Eigen::Isometry3d>;
+
+// The least distance from the moving body's link, carried rigidly along the
+// path's spline (the straight parts are common to every repair), to any
+// obstacle and to the links held on their contacts (`held`: a foot stepping
+// past the other): how well a repair's path clears them, before any posture.
+double sweepClearance(const BodyPath& path, const RobotModel& robot, const Scene& scene, int spot,
+                      const std::vector<PlacedShape>& held) {
+  constexpr int kSamples = 32;
+  const ContactSpot& sp = robot.spots()[spot];
+  const Eigen::Isometry3d spot_in_link = sp.frame.inverse();
+  double clearance = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= kSamples; ++i) {
+    const double s = static_cast<double>(i) / kSamples;
+    if (path.straightAt(s)) continue;
+    const Eigen::Isometry3d link = path.pose(s) * spot_in_link;
+    for (const auto& shape : robot.links()[sp.link].shapes)
+      for (const auto& ob : scene.obstacles())
+        clearance = std::min(clearance, shapeDistance(shape, link * shape.pose, ob.shape, ob.shape.pose));
+    for (const auto& shape : robot.links()[sp.link].shapes)
+      for (const auto& [other, pose] : held)
+        clearance = std::min(clearance, shapeDistance(shape, link * shape.pose, *other, pose));
+  }
+  return clearance;
 }
 
 }  // namespace
@@ -218,7 +247,18 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   Attempt at;
   at.cancel = cancel;
   if (d.kind == TransitionDesign::Kind::Fixed) {
-    out.ok = solveFixed(plan, d, at);
+    // First the knots nearest the witnesses' interpolation. When it cuts
+    // through an obstacle the knots slide along it at the collision margin,
+    // and their optimum can jump from one branch to another between two steps
+    // (a trunk along a table's edge, a knee by 0.06 rad), a jump no refinement
+    // makes valid: then each knot also near its neighbour, as a Move's.
+    out.ok = solveFixed(plan, d, false, at);
+    if (!out.ok && !at.cancelled) {
+      const std::string first = at.reason;
+      at.pieces.clear();
+      out.ok = out.repaired = solveFixed(plan, d, true, at);
+      if (!out.ok && !at.cancelled) at.reason = first + "; each knot near its neighbour too: " + at.reason;
+    }
   } else {
     // The body's ends: its pose in each witness, and the surface normal where it leaves or reaches one.
     BodyPathEnd e0, e1;
@@ -238,19 +278,51 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     const double h = d.leave && !d.arrive ? heightOver(e0, e1) : d.arrive && !d.leave ? heightOver(e1, e0) : -1;
     if (h > 0 && h < lift) lift = std::max(h, 2 * opt_.touch_clearance);
     const BodyPath path(e0, e1, lift);
+    // The links held on their contacts during the motion, where the first witness has them.
+    std::vector<PlacedShape> held;
+    kin_.setConfiguration(plan.stances[d.from].configuration);
+    for (const auto& c : d.motion_contacts) {
+      const int link = sc_.robot->spots()[c.spot].link;
+      if (link == sc_.robot->spots()[d.spot].link) continue;
+      for (const auto& shape : sc_.robot->links()[link].shapes) held.push_back({&shape, kin_.linkPose(link) * shape.pose});
+    }
     std::string reasons;
     for (int attempt = 0; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt) {
       at.pieces.clear();
       const double h = attempt * opt_.repair_step;
-      const BodyPath p = attempt == 0 ? path : path.raised(h);
+      // A repair: the bridge raised by h, or a detour h to either side (the
+      // bridge moved sideways, or one via-point a quarter, half or three
+      // quarters of the way), whichever carries the body farthest from the
+      // obstacles and the held links (the raised one on a tie). Raising alone
+      // does not get a foot past a post; a foot between a post and the other
+      // foot has to step sideways first, then back.
+      BodyPath p = path;
+      std::string how = "as planned";
+      if (attempt > 0) {
+        double best = -std::numeric_limits<double>::infinity();
+        auto consider = [&](BodyPath candidate, std::string label) {
+          const double c = sweepClearance(candidate, *sc_.robot, *sc_.scene, d.spot, held);
+          if (c > best + 1e-9) best = c, p = std::move(candidate), how = std::move(label);
+        };
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "via-point %.2f m up", h);
+        consider(path.raised(h), buf);
+        for (double side : {1.0, -1.0}) {
+          const char* name = side > 0 ? "left" : "right";
+          std::snprintf(buf, sizeof buf, "detour %.2f m %s", h, name);
+          consider(path.bridged(0, side * h), buf);
+          for (double f : {0.25, 0.5, 0.75}) {
+            std::snprintf(buf, sizeof buf, "detour %.2f m %s at %.2f of the way", h, name, f);
+            consider(path.detoured(f, side * h), buf);
+          }
+        }
+      }
       if (solveMove(plan, d, p, at)) {
         out.ok = true;
         out.repaired = attempt > 0;
         break;
       }
-      char buf[64];
-      std::snprintf(buf, sizeof buf, attempt == 0 ? "as planned: " : "via-point %.2f m up: ", h);
-      reasons += (reasons.empty() ? "" : "; ") + std::string(buf) + at.reason;
+      reasons += (reasons.empty() ? "" : "; ") + how + ": " + at.reason;
     }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
@@ -265,7 +337,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   return out;
 }
 
-bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, Attempt& at) {
+bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, Attempt& at) {
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   if (distance(q0, q1) < 1e-9) return true;  // the witnesses coincide: only the contacts' support changes
@@ -279,7 +351,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, A
     r.contacts = d.motion_contacts;
     r.initial_guess = guess;
     const Configuration ref = lerp(q0, q1, alpha);
-    r.cost = std::make_shared<ReferencePostureCost>(ref);
+    r.cost = std::make_shared<ReferencePostureCost>(follow ? lerp(guess, ref, 0.5) : ref);
     PostureResult res = generator_.solve(r);
     ++at.posture_calls;
     at.posture_seconds += res.seconds;
@@ -396,6 +468,17 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     for (std::size_t k = 0; k < targets.size(); ++k) {
       res = attempt(targets[k], guess);
       if (!res.success()) res = attempt(targets[k], ref);  // from the interpolated witnesses instead of the previous step
+      // Last, for the loosest target only (a stricter one has the next
+      // target to fall back on): from the witnesses, the nearer first, which
+      // hold the motion's contacts as the interpolation does not. A thigh
+      // pivoting off a seat, its leg's thigh and foot contacts
+      // over-constraining the solver, found no posture at the top of its
+      // lift from the previous step or the interpolation, and one from the
+      // witness it rises to.
+      for (const Configuration* w : {s < 0.5 ? &q0 : &q1, s < 0.5 ? &q1 : &q0}) {
+        if (res.success() || k + 1 < targets.size()) break;
+        res = attempt(targets[k], *w);
+      }
       if (res.success()) {
         loose_only = loose_only || k > 0;
         return res.configuration;

@@ -7,8 +7,10 @@
 //   Fixed  the same contacts, or one contact's support flipped: every contact
 //          held, the supporting ones those supporting in either stance; knots
 //          at one step per fixed_step of change (n at most), cost the distance
-//          to the linear interpolation of the two witnesses. No motion at all
-//          when the witnesses coincide.
+//          to the linear interpolation of the two witnesses; when that fails,
+//          solved again with each knot also near the previous one (a Move's
+//          cost: the knots stay on one branch). No motion at all when the
+//          witnesses coincide.
 //   Move   a contact removed, added, or removed and then added again for the
 //          same spot (a -> b -> c merged, the settled stance b giving the
 //          contacts held in the air): the moving body follows a BodyPath from
@@ -18,6 +20,9 @@
 //          witnesses' interpolation plus the distance to the previous step.
 //          A body that cannot follow the path exactly near a surface (a thigh
 //          whose foot is planted) pivots: height held, straight_slack across.
+//          A knot found neither from the previous one nor from the witnesses'
+//          interpolation is sought from each witness, which holds the motion's
+//          contacts.
 //          The body leaves (reaches) a surface in a short piece that keeps the
 //          contact: the phase changes when it is `touch_clearance` off the
 //          surface, where no check can mistake it for a collision.
@@ -26,8 +31,10 @@
 // sample the time law makes of the piece is checked the same way, and the
 // segment of a failing sample refined (so every output sample is valid). A
 // Move whose path collides (a knot infeasible, or a segment that refinement
-// cannot fix) is repaired by raising its spline into a bridge, higher on each
-// attempt.
+// cannot fix) is repaired, farther on each attempt, by raising its spline into
+// a bridge or by a detour to either side, whichever carries the moving link
+// (rigidly, along the spline) farthest from the obstacles and the links held
+// on their contacts.
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -107,7 +114,8 @@ class TransitionSolver {
 
  private:
   struct Attempt;
-  bool solveFixed(const Plan& plan, const TransitionDesign& d, Attempt& at);
+  // `follow`: the cost also holds each knot near the previous one.
+  bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, Attempt& at);
   bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, Attempt& at);
 
   const Scenario& sc_;

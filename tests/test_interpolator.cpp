@@ -179,6 +179,36 @@ TEST(BodyPath, RaisedPathPassesHigher) {
   EXPECT_LT((r.pose(1).translation() - b.pose.translation()).norm(), 1e-12);
 }
 
+TEST(BodyPath, DetoursPassBeside) {
+  BodyPathEnd a, b;
+  a.normal = b.normal = Eigen::Vector3d::UnitZ();
+  b.pose.translation() = Eigen::Vector3d(0.3, 0, 0);
+  const BodyPath p(a, b, 0.03);
+  // The chord runs along x: left is +y. Both stay at the straight parts' height.
+  const BodyPath left = p.bridged(0, 0.1), right = p.bridged(0, -0.1);
+  ASSERT_EQ(left.vias().size(), 2u);
+  for (const auto& v : left.vias()) {
+    EXPECT_NEAR(v.y(), 0.1, 1e-12);
+    EXPECT_NEAR(v.z(), 0.03, 1e-12);
+  }
+  for (const auto& v : right.vias()) EXPECT_NEAR(v.y(), -0.1, 1e-12);
+  EXPECT_GT(left.pose(0.5).translation().y(), 0.09);
+  // One via-point a quarter of the way: the body turns aside early, then comes back.
+  const BodyPath early = p.detoured(0.25, -0.1);
+  ASSERT_EQ(early.vias().size(), 1u);
+  EXPECT_LT((early.vias()[0] - Eigen::Vector3d(0.075, -0.1, 0.03)).norm(), 1e-12);
+  double y_min = 0, x_at_min = 0;
+  for (int i = 0; i <= 200; ++i) {
+    const Eigen::Vector3d q = early.pose(i / 200.0).translation();
+    if (q.y() < y_min) y_min = q.y(), x_at_min = q.x();
+  }
+  EXPECT_LT(y_min, -0.095);
+  EXPECT_LT(x_at_min, 0.15);
+  // The ends are the witnesses' poses, whatever the detour.
+  EXPECT_LT((early.pose(1).translation() - b.pose.translation()).norm(), 1e-12);
+  EXPECT_LT(early.pose(0).translation().norm(), 1e-12);
+}
+
 // --- The time law -----------------------------------------------------------
 
 namespace {
@@ -394,6 +424,164 @@ TEST(Interpolator, ThighPivotsOffTheSeatWithItsFootPlanted) {
   const Surface& seat = sc.scene->surfaces()[sc.scene->surfaceIndex("chair_seat")];
   const double rise = (seat.frame.inverse() * spotAt(sc, r.trajectory.samples.back().q, l_thigh).translation()).z();
   EXPECT_GT(rise, 1e-3);
+}
+
+namespace {
+// A stance of a plan the contact planner made for models/scenarios/chair_table.yaml
+// (the seat at 0.31 m, the thigh spots near the hips), its witness as the plan
+// file has it (17 digits): the transitions between them failed.
+struct RecordedContact {
+  const char* spot;
+  const char* surface;
+  bool supporting;
+  double x, y, theta;
+};
+struct RecordedStance {
+  std::vector<RecordedContact> contacts;
+  double base[7];    // position, orientation (w, x, y, z)
+  double joints[30];
+};
+
+template <std::size_t N>
+Plan recordedPlan(const Scenario& sc, const RecordedStance (&stances)[N]) {
+  Plan p;
+  p.scenario = sc.path;
+  for (const RecordedStance& r : stances) {
+    std::vector<ContactSpec> contacts;
+    for (const RecordedContact& c : r.contacts) {
+      ContactSpec spec;
+      spec.spot = sc.robot->spotIndex(c.spot);
+      spec.surface = sc.scene->surfaceIndex(c.surface);
+      spec.supporting = c.supporting;
+      spec.placement = {c.x, c.y, c.theta};
+      contacts.push_back(spec);
+    }
+    Configuration q;
+    q.base_position = Eigen::Vector3d(r.base[0], r.base[1], r.base[2]);
+    q.base_orientation = Eigen::Quaterniond(r.base[3], r.base[4], r.base[5], r.base[6]).normalized();
+    q.joints = Eigen::Map<const Eigen::VectorXd>(r.joints, 30);
+    p.stances.push_back(stance(contacts, q));
+  }
+  return p;
+}
+
+// Seated with both feet drawn back, the left thigh touching without support,
+// then gone: the thigh (its spot near the hip) leaves the seat with its foot
+// planted and the right thigh on the seat.
+const RecordedStance kThighOffTheLowSeat[] = {
+    {{{"r_sole", "floor", true, -0.34062413564312166, -0.5950000000000001, -1.694818351060766e-31}, {"l_sole", "floor", true, -0.34062413564312166, -0.40500000000000014, -1.694818351060766e-31}, {"r_thigh", "chair_seat", true, 0.11000000000000007, -0.09500000000000001, -3.3306690738754696e-16}, {"l_thigh", "chair_seat", false, 0.11000000000000007, 0.09499999999999999, -3.3306690738754696e-16}},
+     {-5.584722026519483e-08, 9.890621899151338e-15, 0.36999989452261783, 0.9999999899246547, 2.2508074537946163e-12, -0.00014195312804372298, 5.875821903132437e-12},
+     {-1.1758518170085896e-11, -4.498383885851371e-12, -1.5705124024974, 2.0586677666251414, -0.4878714518930889, -1.5624689717782665e-13,
+      -1.1768466511330085e-11, -4.517586691261167e-12, -1.570512402497376, 2.05866776661964, -0.48787145188760717, -1.3632075501143532e-13,
+      0.00020068510987070274, 0.0003418409370310857, -3.497245855428222e-06, 2.777437666535976e-05, 0.26180443192579167, -0.17461556424716718,
+      -1.3156514635927495e-05, -0.5236656930471043, 1.3104869393844671e-06, -2.0747487758112637e-05, 0.10000368392426331, 0.2617413313034878,
+      0.1745307215790412, 3.2740625002206526e-07, -0.5236823440628274, 1.071142139214719e-06, -1.6410836622609068e-05, 0.0999954081943104}},
+    {{{"r_sole", "floor", true, -0.34062413564312166, -0.5950000000000001, -1.694818351060766e-31}, {"l_sole", "floor", true, -0.34062413564312166, -0.40500000000000014, -1.694818351060766e-31}, {"r_thigh", "chair_seat", true, 0.11000000000000007, -0.09500000000000001, -3.3306690738754696e-16}},
+     {-0.0005151194830646988, -0.00013784663414074616, 0.37507391725798234, 0.9996331845987106, 0.026714118592931827, 0.0009524472285201832, 0.004352580972239828},
+     {-0.008765489354021114, -0.053425814255809306, -1.572936122875183, 2.05866776664398, -0.48787145191221915, -8.0071472892638e-13,
+      -0.008763341026913974, -0.05242383456091896, -1.5411815180405222, 2.022460465943194, -0.4834186483427041, -0.0010019818923758049,
+      0.002744004923295172, 0.003339011413551505, 3.4653974083780265e-05, -0.00010126847946966558, 0.2613249420478446, -0.1741154247951847,
+      -3.920562324731078e-05, -0.5233372150090173, -3.806692588828565e-05, 0.00011596127037920817, 0.10001248082387801, 0.2615110269906669,
+      0.17460702089165453, -2.005837193405028e-05, -0.523465670573795, -5.7584541594818306e-05, 3.674621388771444e-05, 0.10004809203436914}},
+};
+// Standing between the chair and the table, the trunk under the table's
+// edge, the left foot unloaded: the witnesses' interpolation goes 9.5 mm
+// into the table, and the knots nearest it slide along the edge.
+const RecordedStance kTrunkAlongTheTableEdge[] = {
+    {{{"l_sole", "floor", true, -0.2204287952410844, -0.4054650089451721, -0.1441110047939088}, {"r_sole", "floor", true, -0.31016218100511656, -0.5374821100846995, -0.20116324598533253}},
+     {0.13062414251000773, 0.15548898253776916, 0.4753482221025536, 0.9992784522836312, -0.01674683609095991, 0.028408849242444956, -0.018842918226573364},
+     {-0.17335705957866465, -0.17523737298611816, -1.131013804529994, 1.7138938631296443, -0.633453020396258, 0.21873964982453947,
+      -0.12408794508478634, -0.3082572282810085, -1.2373121584136826, 1.5783661825333635, -0.3958216670759436, 0.3490645351632778,
+      -0.0005837995786085977, 0.40104418439183687, -6.844909389325322e-05, 0.0016627223024512118, 0.24970434392028534, -0.17752048671515916,
+      -0.0006970726596795621, -0.528465653310838, 1.957277245383723e-05, -0.00037456021191882414, 0.09997384151987336, 0.25007935251488655,
+      0.17396348885883356, -7.284734501998924e-05, -0.5287067628008172, -1.7893116426228982e-05, -0.0005386549471532412, 0.10001234985484711}},
+    {{{"l_sole", "floor", false, -0.2204287952410844, -0.4054650089451721, -0.1441110047939088}, {"r_sole", "floor", true, -0.31016218100511656, -0.5374821100846995, -0.20116324598533253}},
+     {0.08426845372302362, 0.06835764149667953, 0.4300995805036574, 0.9990160315401083, 0.03785835749193048, 0.0035053610045959974, -0.02283475285817726},
+     {-0.15547297466899018, -0.03744558945355125, -1.3395603543255352, 1.942821727574005, -0.6235915960561041, -0.03584717578117508,
+      -0.10099699286315837, -0.19559037907306553, -1.4132893255046124, 1.7374446656394964, -0.3405755845273063, 0.12127900856358331,
+      -0.036459324839435786, 0.1736003501534375, -0.0022959943831994895, -0.0014138829639055994, 0.2707191686047443, -0.23916210221476664,
+      -0.012557300827800988, -0.5178265893804566, -8.240643952716988e-05, 0.000705756060067736, 0.09973461012557487, 0.2708919085181168,
+      0.10885604662282661, -0.012792192594028307, -0.5223426171116594, 7.213412154632357e-06, 0.0001498738636742066, 0.09973657366617093}},
+};
+// The right foot leaves the floor in front of the chair's front left leg and
+// is put down beside the chair, between that leg and the left foot: the
+// spline (or any bridge over it) crosses the leg.
+const RecordedStance kFootPastTheChairLeg[] = {
+    {{{"r_sole", "floor", false, -0.2601006462252855, -0.2752004636389681, -0.060225824888427405}, {"l_sole", "floor", true, -0.3108440957048783, -0.04446177590047818, -0.06750112417739565}},
+     {0.08260548928268828, 0.3820590822380497, 0.5717296860666456, 0.9995374107033367, -0.030338703214465357, -0.0002787580835416743, 0.002109498913196654},
+     {-0.06409522015915685, -0.050764988333098296, -0.9034193847335812, 1.1564066059350662, -0.2486472039701228, 0.11129980760231324,
+      -0.07171964595506344, 0.029764998489133485, -0.8827253258682508, 1.3246656510997343, -0.43716377998225997, 0.03073600716659612,
+      0.03628686310835772, 0.24957212451970964, 0.0015922374052057225, 0.000510517663228838, 0.2574335420342838, -0.12990747120736723,
+      0.00866441167271816, -0.5270494138740103, -5.668149765732707e-06, -0.0003434635578183601, 0.10016105996193332, 0.25837857711302303,
+      0.21990709688347454, 0.0087232095452493, -0.5236320940845478, -3.8256866602998096e-05, 1.3592881511925725e-05, 0.10015863756420701}},
+    {{{"l_sole", "floor", true, -0.3108440957048783, -0.04446177590047818, -0.06750112417739565}},
+     {0.04910782404440655, 0.4093588920691384, 0.6187483930929258, 0.9998596329970583, -0.010568638673416397, 0.012727930824423144, -0.002649142598545151},
+     {0.004092448895031181, -0.003180940961803538, -0.8079337770191038, 1.3390013036116521, -0.595129047880008, -0.0007768057660305742,
+      -0.06377392099815085, -0.053969619028345864, -0.7715782355322097, 0.961237800582307, -0.2137263731850006, 0.07673324516566392,
+      -0.0009733880635244138, 0.25815616164052274, -3.927727255324591e-05, 0.0028407915209808805, 0.242870402738328, -0.17794412168023177,
+      -0.0007100311170100426, -0.531315880826934, -4.643216740896503e-05, -0.0008005086289731311, 0.0999785024538159, 0.24285685584666644,
+      0.17567669991576526, 0.0002243067460146442, -0.5313831150067315, -1.813610428208692e-06, -0.0007804230145823032, 0.099990883735202}},
+    {{{"l_sole", "floor", true, -0.3108440957048783, -0.04446177590047818, -0.06750112417739565}, {"r_sole", "floor", false, -0.4212033572540977, -0.19044043110866848, 0.005906082803170731}},
+     {0.04177080634620333, 0.40681264680231166, 0.6034829614179438, 0.9996889921396026, 0.0020921194370840876, 0.024850228800858708, 9.033112224969427e-05},
+     {0.005367814531339846, -0.009428148072356687, -0.7108345704304406, 1.1747398027207498, -0.5135874113647064, 0.004962954516388576,
+      -0.07133160778275753, -0.07339311494788588, -0.8546975415611596, 1.0350472856011164, -0.2303592147232418, 0.07266601471646765,
+      -0.00230468555919517, 0.3039199504853313, -8.280484891066606e-05, 0.004574123299769566, 0.23020069767467677, -0.18002568307337097,
+      -0.0010989734264850535, -0.5367451590310802, -1.3535750869082875e-05, -0.0013659247596831984, 0.0999819339193802, 0.2302444033996327,
+      0.17525923741668603, 0.00013826924908895595, -0.5368133067068712, -1.4075036156077169e-05, -0.0013463788726907672, 0.10000432201555429}},
+};
+
+}  // namespace
+
+TEST(Interpolator, ThighNearTheHipPivotsOffTheLowSeat) {
+  // The posture at the top of the thigh's lift was found neither from the
+  // previous step nor from the witnesses' interpolation (the right leg's
+  // thigh and foot contacts over-constrain the solver), but from the witness
+  // the thigh rises to.
+  const Scenario& sc = chairScenario();
+  const Plan plan = recordedPlan(sc, kThighOffTheLowSeat);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 0);
+  expectValid(r.trajectory, sc);
+  const Surface& seat = sc.scene->surfaces()[sc.scene->surfaceIndex("chair_seat")];
+  const int l_thigh = sc.robot->spotIndex("l_thigh");
+  const double rise = (seat.frame.inverse() * spotAt(sc, r.trajectory.samples.back().q, l_thigh).translation()).z();
+  EXPECT_GT(rise, 5e-3);
+}
+
+TEST(Interpolator, WeightShiftWithTheTrunkAlongTheTableEdge) {
+  // Knots nearest the witnesses' interpolation jumped between two branches
+  // (a knee by 0.06 rad) while the abdomen slid along the table's edge, and
+  // the linear interpolation between them went 0.7 mm into the table however
+  // refined: solved again with each knot also near its neighbour.
+  const Scenario& sc = chairScenario();
+  const Plan plan = recordedPlan(sc, kTrunkAlongTheTableEdge);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+}
+
+TEST(Interpolator, FootDetoursPastTheChairLegBesideTheOtherFoot) {
+  // No bridge clears a chair leg 0.28 m high; the repair whose path carries
+  // the foot farthest from the obstacles and from the planted foot steps
+  // sideways first (a via-point a quarter of the way), then back.
+  const Scenario& sc = chairScenario();
+  const Plan plan = recordedPlan(sc, kFootPastTheChairLeg);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+  opt.repair_attempts = 0;
+  const InterpolationResult u = interpolate(plan, sc, opt);
+  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
+  EXPECT_NE(u.reason.find("stances 0 -> 2"), std::string::npos) << u.reason;
 }
 
 TEST(Interpolator, BadInputAndCancellation) {
