@@ -28,8 +28,8 @@ int main(int argc, char** argv) {
                               {"distance to goal instead of f_T", true, true, false, true}};
   std::printf("scenario %s, budget per run: %s\n", sc.name.c_str(),
               max_seconds > 0 ? (std::to_string(max_seconds) + " s").c_str() : "the scenario's");
-  std::printf("%-52s %-22s %9s %7s %9s %9s %8s\n", "variant", "result", "seconds", "nodes", "calls", "failed",
-              "stances");
+  std::printf("%-52s %-22s %9s %7s %9s %9s %10s %8s\n", "variant", "result", "seconds", "nodes", "calls", "failed",
+              "remembered", "stances");
   for (const auto& v : variants) {
     PlannerParameters p = plannerParameters(sc);
     if (max_seconds > 0) p.max_seconds = max_seconds;
@@ -38,8 +38,9 @@ int main(int argc, char** argv) {
     p.guide_potential = v.guide;
     p.failure_memory = v.memory;
     const PlanningResult r = ContactPlanner(sc, p).plan();
-    std::printf("%-52s %-22s %9.2f %7ld %9ld %9ld %8zu\n", v.name, toString(r.status), r.stats.seconds,
-                r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures, r.plan.stances.size());
+    std::printf("%-52s %-22s %9.2f %7ld %9ld %9ld %10ld %8zu\n", v.name, toString(r.status), r.stats.seconds,
+                r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures, r.stats.pairs_remembered,
+                r.plan.stances.size());
     std::fflush(stdout);
   }
   return 0;

@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
       "Multicast: run it inside a private network namespace (scripts/run-pipeline does) or on a lab\n"
       "network with ttl=1 (README, 'Across machines')."};
   std::string scenario_path, out_dir = "acyclic-run", url = proc::defaultLcmUrl(), bin_dir = executableDir();
-  double timeout_s = 900;
+  double timeout_s = 3600;  // the chair: planning takes minutes, and its motion plays in real time
   long seed = -1;
   double budget_s = -1;
   std::int64_t request_id = 1;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <deque>
 #include <cmath>
+#include <optional>
 #include <queue>
 #include <random>
 #include <thread>
@@ -83,6 +84,7 @@ struct ContactPlanner::Impl {
     Change change = Change::Root;
     int generator = -1;                   // the pair generator that made it (lazy sons)
     int depth = 0;                        // contact changes from the start (set by addNode)
+    bool dead = false;                    // no plan can be exported through it (exportPlan): not expanded
     std::vector<std::pair<int, int>> failed_pairs;  // (spot, surface): first candidate failed here
   };
   struct PairGenerator {
@@ -484,10 +486,43 @@ struct ContactPlanner::Impl {
   // stance between two of them where the earlier change settles (an added
   // contact starts to support, a removed one is gone), so that consecutive
   // stances differ by one contact (DESIGN.md section 8).
-  Plan exportPlan(int last) {
+  // A witness for the stance `contacts` between a removal (witness `removed`)
+  // and an addition (witness `added`), accepted by the independent check, or
+  // none (see exportPlan).
+  std::optional<Configuration> settledWitness(const std::vector<ContactSpec>& contacts, const Configuration& added,
+                                              const Configuration& removed) {
+    auto valid = [&](const Configuration& q) { return checker.checkPosture(q, contacts).valid(); };
+    auto solve = [&](const Configuration& guess, PostureGenerator* generator) -> std::optional<Configuration> {
+      PostureRequest r;
+      r.contacts = contacts;
+      r.initial_guess = guess;
+      r.cost = costFrom(guess);
+      PostureResult res;
+      if (generator) {
+        res = generator->solve(r);
+        ++stats.posture_calls;
+        if (!res.success()) ++stats.posture_failures;
+      } else {
+        res = solveAll({r})[0];
+      }
+      if (res.success() && valid(res.configuration)) return res.configuration;
+      return std::nullopt;
+    };
+    if (auto q = solve(added, nullptr)) return q;
+    if (auto q = solve(removed, nullptr)) return q;
+    if (valid(removed)) return removed;
+    PostureGeneratorOptions patient = p.posture;
+    patient.max_iterations = std::max(300, p.posture.max_iterations);
+    PostureGenerator generator(sc.robot, sc.scene, patient);
+    return solve(added, &generator);
+  }
+
+  // Returns false, and marks the node where it fails dead, when a settled
+  // stance gets no valid witness.
+  bool exportPlan(int last, Plan& plan) {
     std::vector<int> path;
     for (int n = last; n >= 0; n = nodes[n].parent) path.insert(path.begin(), n);
-    Plan plan;
+    plan = Plan();
     plan.scenario = sc.path;
     plan.robot = sc.robot->descriptionPath();
     auto push = [&](const std::vector<ContactSpec>& specs, const Configuration& q) {
@@ -516,16 +551,18 @@ struct ContactPlanner::Impl {
         } else if (cur.change == Change::Removed) {
           push(prev.contacts, cur.q);
         } else {
-          PostureRequest r;
-          r.contacts = prev.contacts;
-          r.initial_guess = cur.q;
-          r.cost = costFrom(cur.q);
-          PostureResult res = solveAll({r})[0];
-          if (!res.success()) {
-            r.initial_guess = prev.q;
-            res = solveAll({r})[0];
+          // prev was a removal and cur adds a contact: prev's witness still
+          // touches with the removed contact, cur's with the added one. The
+          // first the independent check accepts: a witness of its own from
+          // cur's, then from prev's; prev's own (the removed body may rest
+          // on its surface's edge of validity); from cur's with a long
+          // iteration budget. Without one no plan goes through cur.
+          std::optional<Configuration> settled = settledWitness(prev.contacts, cur.q, prev.q);
+          if (!settled) {
+            nodes[path[i]].dead = true;
+            return false;
           }
-          push(prev.contacts, res.success() ? res.configuration : prev.q);
+          push(prev.contacts, *settled);
         }
       }
       push(cur.transition, cur.q);
@@ -535,7 +572,13 @@ struct ContactPlanner::Impl {
     plan.stats.posture_calls = stats.posture_calls;
     plan.stats.posture_failures = stats.posture_failures;
     plan.stats.seconds = elapsed();
-    return plan;
+    return true;
+  }
+
+  bool deadPath(int n) const {
+    for (; n >= 0; n = nodes[n].parent)
+      if (nodes[n].dead) return true;
+    return false;
   }
 };
 
@@ -561,7 +604,20 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   }
   I.addNode(root);
   double last_report = -1;
-  while (I.goal_node < 0) {
+  Plan plan;
+  bool exported = false;
+  while (true) {
+    if (I.goal_node >= 0) {
+      // A goal whose plan cannot be exported (a settled stance without a
+      // valid witness) is dropped with the node where it fails; the search
+      // goes on.
+      if (I.exportPlan(I.goal_node, plan)) {
+        exported = true;
+        break;
+      }
+      ++I.stats.check_refusals;
+      I.goal_node = -1;
+    }
     if (!I.budgetLeft()) break;
     if (I.open.empty()) {
       I.stop = PlanningResult::Status::NoSolution;
@@ -570,6 +626,7 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
     }
     const Impl::Entry e = I.open.top();
     I.open.pop();
+    if (I.deadPath(e.node)) continue;
     const int gen = I.nodes[e.node].generator;
     I.expand(e.node);
     if (gen >= 0 && I.p.lazy_sons) I.nextSon(gen);  // its pair's next son, now that this one is taken
@@ -581,9 +638,9 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   }
   I.stats.seconds = I.elapsed();
   out.stats = I.stats;
-  if (I.goal_node >= 0) {
+  if (exported) {
     out.status = PlanningResult::Status::Solved;
-    out.plan = I.exportPlan(I.goal_node);
+    out.plan = std::move(plan);
     out.stats = I.stats;
     out.plan.stats.seconds = out.stats.seconds = I.elapsed();
   } else {
