@@ -19,6 +19,17 @@ TEST(AcyclicCheck, ChairStartStanceIsValid) {
   EXPECT_NE(r.output.find("start stance: valid"), std::string::npos) << r.output;
 }
 
+TEST(AcyclicCheck, ThePlannersChairPlanIsValid) {
+  // tests/data/chair.plan.json: the planner's plan for the chair scenario
+  // (84 stances, acyclic-planner --in models/scenarios/chair_table.yaml),
+  // kept as written: every stance and the sequence pass the contract.
+  const acyclic::test::ProcessRun r = run(acyclic::test::sourcePath("models/scenarios/chair_table.yaml") + " --plan " +
+                                          acyclic::test::sourcePath("tests/data/chair.plan.json"));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("84 of 84 stances valid"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("plan: valid"), std::string::npos) << r.output;
+}
+
 TEST(AcyclicCheck, ViolationsArePrintedWithFiguresAndFail) {
   acyclic::test::TempDir dir;
   std::string text = acyclic::test::scenarioText("models/scenarios/chair_table.yaml");

@@ -300,6 +300,46 @@ TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
   }
 }
 
+// The planner's whole chair plan (tests/data/chair.plan.json, 84 stances) in
+// a real browser: the page loads the robot and every stance, each drawn with
+// its contacts (supporting ones counted) and forces, offline.
+TEST(ViewerChair, TheWholeChairPlanInHeadlessChromium) {
+  const char* env = std::getenv("CHROMIUM");
+  const std::string chromium = env ? env : "/usr/bin/chromium";
+  ASSERT_TRUE(std::filesystem::exists(chromium))
+      << chromium << " not found: the browser test needs Debian's chromium (scripts/install-deps installs it)";
+  const Scenario sc = Scenario::load(sourcePath("models/scenarios/chair_table.yaml"));
+  const Plan plan = readPlan(sourcePath("tests/data/chair.plan.json"), sc);
+  TempDir out;
+  const std::string page = out.path() + "/page";
+  auto r = runProcess(binaryPath("processes/acyclic-view") + " --scenario " +
+                      sourcePath("models/scenarios/chair_table.yaml") + " --plan " +
+                      sourcePath("tests/data/chair.plan.json") + " --out " + page);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string state_path = out.path() + "/state.json";
+  r = runProcess("node " + sourcePath("viewer/tools/snap.mjs") + " " + page +
+                 " --query 'stance=0' --width 480 --height 320 --visit-stances --state " + state_path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(readFile(state_path));
+  const auto& st = j.at("state");
+  EXPECT_TRUE(st.at("loaded").get<bool>());
+  EXPECT_TRUE(st.at("error").is_null()) << st.at("error");
+  EXPECT_EQ(st.at("scenario"), "chair_table");
+  EXPECT_EQ(st.at("stances").get<std::size_t>(), plan.stances.size());
+  EXPECT_EQ(st.at("robotMeshes").get<std::size_t>(), viewShapes(*sc.robot).size());
+  EXPECT_TRUE(j.at("remote_requests").empty()) << j.at("remote_requests");
+  const auto& visits = j.at("visits").at("stances");
+  ASSERT_EQ(visits.size(), plan.stances.size());
+  for (std::size_t i = 0; i < visits.size(); ++i) {
+    int supporting = 0;
+    for (const auto& c : plan.stances[i].contacts) supporting += c.spec.supporting;
+    EXPECT_EQ(visits[i].at("current").at("stance").get<std::size_t>(), i);
+    EXPECT_EQ(visits[i].at("drawn").at("contacts").get<std::size_t>(), plan.stances[i].contacts.size()) << i;
+    EXPECT_EQ(visits[i].at("drawn").at("supporting").get<int>(), supporting) << i;
+    EXPECT_GT(visits[i].at("drawn").at("arrows").get<int>(), 0) << i;
+  }
+}
+
 // The picture: a strip of the chair plan (a fixed file, so the picture does
 // not move when the planner changes), within a tolerance of the reference
 // (software rendering; README "Viewer" says how to remake the reference).
