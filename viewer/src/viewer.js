@@ -347,9 +347,11 @@ function main() {
   }
 
   let playStart = 0, playFrom = 0;
-  function tick(now) {
+  function tick() {
     if (!state.playing) return;
-    const t = playFrom + (now - playStart) / 1000;
+    // performance.now(), not the frame's timestamp: that one can be earlier
+    // than play() itself, and the timeline would stand still at its start.
+    const t = playFrom + Math.max(0, performance.now() - playStart) / 1000;
     const end = data.frames[data.frames.length - 1].t;
     setTime(Math.min(t, end));
     if (t >= end) return pause();

@@ -78,14 +78,15 @@ try {
       const stances = [], frames = [];
       for (let i = 0; i < v.stances; ++i) { const c = v.setStance(i); stances.push({ current: c, drawn: v.drawn }); }
       for (let i = 0; i < v.frames; ++i) { const c = v.setFrame(i); frames.push({ current: c, drawn: v.drawn }); }
-      // Play from the start: the timeline moves within 10 s of wall time (the
-      // renders queued by the visits above go first on a software renderer).
+      // Play from the start: the timeline moves within 30 s of wall time (the
+      // renders queued by the visits above go first on a software renderer,
+      // and a loaded machine gives animation frames late).
       let play = null;
       if (v.frames > 1) {
         v.setFrame(0);
         v.play();
         const playing = v.playing;
-        for (let k = 0; k < 100 && !(v.current.t > 0); ++k) await new Promise((r) => setTimeout(r, 100));
+        for (let k = 0; k < 300 && !(v.current.t > 0); ++k) await new Promise((r) => setTimeout(r, 100));
         play = { playing, t: v.current.t, mode: v.current.mode };
         v.pause();
       }
