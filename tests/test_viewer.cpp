@@ -247,11 +247,18 @@ TEST_F(Viewer, AcyclicViewRefusesBadInputNamingTheFile) {
 // The page in a real browser: it loads the robot, every stance and every
 // frame (checked through its own state, window.acyclicViewer) and asks
 // nothing of the network.
-TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
+// The browser tests need Debian's chromium ($CHROMIUM, else /usr/bin/chromium).
+std::string chromiumPath() {
   const char* env = std::getenv("CHROMIUM");
-  const std::string chromium = env ? env : "/usr/bin/chromium";
-  ASSERT_TRUE(std::filesystem::exists(chromium))
-      << chromium << " not found: the browser test needs Debian's chromium (scripts/install-deps installs it)";
+  return env ? env : "/usr/bin/chromium";
+}
+bool haveChromium() { return std::filesystem::exists(chromiumPath()); }
+std::string chromiumMissing() {
+  return chromiumPath() + " not found: the browser test needs Debian's chromium (scripts/install-deps installs it)";
+}
+
+TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
+  ASSERT_TRUE(haveChromium()) << chromiumMissing();
   TempDir out;
   const std::string page = out.path() + "/page";
   auto r = runProcess(binaryPath("processes/acyclic-view") + " --scenario " + sourcePath(kScenario) + " --plan " +
@@ -304,10 +311,7 @@ TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
 // a real browser: the page loads the robot and every stance, each drawn with
 // its contacts (supporting ones counted) and forces, offline.
 TEST(ViewerChair, TheWholeChairPlanInHeadlessChromium) {
-  const char* env = std::getenv("CHROMIUM");
-  const std::string chromium = env ? env : "/usr/bin/chromium";
-  ASSERT_TRUE(std::filesystem::exists(chromium))
-      << chromium << " not found: the browser test needs Debian's chromium (scripts/install-deps installs it)";
+  ASSERT_TRUE(haveChromium()) << chromiumMissing();
   const Scenario sc = Scenario::load(sourcePath("models/scenarios/chair_table.yaml"));
   const Plan plan = readPlan(sourcePath("tests/data/chair.plan.json"), sc);
   TempDir out;
@@ -344,10 +348,7 @@ TEST(ViewerChair, TheWholeChairPlanInHeadlessChromium) {
 // not move when the planner changes), within a tolerance of the reference
 // (software rendering; README "Viewer" says how to remake the reference).
 TEST(ViewerChair, StripInHeadlessChromiumMatchesTheReference) {
-  const char* env = std::getenv("CHROMIUM");
-  const std::string chromium = env ? env : "/usr/bin/chromium";
-  ASSERT_TRUE(std::filesystem::exists(chromium))
-      << chromium << " not found: the browser test needs Debian's chromium (scripts/install-deps installs it)";
+  ASSERT_TRUE(haveChromium()) << chromiumMissing();
   TempDir out;
   const std::string page = out.path() + "/page";
   auto r = runProcess(binaryPath("processes/acyclic-view") + " --scenario " +

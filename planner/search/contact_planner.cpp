@@ -482,10 +482,6 @@ struct ContactPlanner::Impl {
     }
   }
 
-  // The plan along the path to `last`: each node's transition stance, with a
-  // stance between two of them where the earlier change settles (an added
-  // contact starts to support, a removed one is gone), so that consecutive
-  // stances differ by one contact (DESIGN.md section 8).
   // A witness for the stance `contacts` between a removal (witness `removed`)
   // and an addition (witness `added`), accepted by the independent check, or
   // none (see exportPlan).
@@ -517,6 +513,10 @@ struct ContactPlanner::Impl {
     return solve(added, &generator);
   }
 
+  // The plan along the path to `last`: each node's transition stance, with a
+  // stance between two of them where the earlier change settles (an added
+  // contact starts to support, a removed one is gone), so that consecutive
+  // stances differ by one contact (DESIGN.md section 8).
   // Returns false, and marks the node where it fails dead, when a settled
   // stance gets no valid witness.
   bool exportPlan(int last, Plan& plan) {
