@@ -1,6 +1,7 @@
 // The posture generator: its derivatives against finite differences, and the
 // cases of the posture-generator issue, each result re-verified by the
 // independent validity check (limits, contacts, collisions, quasi-static LP).
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -504,4 +505,27 @@ TEST(PostureGenerator, TwoGeneratorsOnTwoThreadsAgreeWithOne) {
     EXPECT_EQ(ref[i], a[i]) << i;
     EXPECT_EQ(ref[i], b[i]) << i;
   }
+}
+
+// libacyclic_mumps_lock.so must be the definition the process uses for both
+// MUMPS entry points it replaces: dmumps_c (the lock) and the per-call
+// memory-save estimate (a fifth of a solve's CPU, planner/posture/mumps_lock.cpp).
+// A link order that puts libdmumps_seq first would silently lose both.
+TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
+  for (const char* name : {"dmumps_c", "__dmumps_save_restore_MOD_dmumps_compute_memory_save"}) {
+    void* sym = dlsym(RTLD_DEFAULT, name);
+    ASSERT_NE(sym, nullptr) << name;
+    Dl_info info{};
+    ASSERT_NE(dladdr(sym, &info), 0) << name;
+    EXPECT_NE(std::string(info.dli_fname).find("acyclic_mumps_lock"), std::string::npos)
+        << name << " resolves to " << info.dli_fname;
+  }
+  // And MUMPS still solves through them: the chair's start stance from a perturbed guess.
+  const Scenario& sc = chair();
+  std::mt19937 rng(3);
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = perturbed(sc.start, rng, 0.05, 0.02);
+  PostureGenerator pg(sc.robot, sc.scene);
+  EXPECT_TRUE(pg.solve(r).success());
 }
