@@ -1,9 +1,10 @@
 // The trajectory interpolator on a plan: wall time (and its share in the
 // posture generator), posture calls, repairs, filtered stances, samples, for
 // n = 10 and 20 steps, with every sample verified (the default) and without
-// (knots and segment middles only: what the verification costs); then the
-// independent trajectory check of the default n = 20 run. Figures quoted in
-// the README.
+// (knots and segment middles only: what the verification costs), on one
+// thread and on two (whether both give the same trajectory is printed); then
+// the independent trajectory check of the default n = 20 run. Figures quoted
+// in the README.
 // Usage: bench_interpolator [PLAN.json [SCENARIO]] [--cutoff M] [--ipopt name=value ...]
 //   Without a plan: plans models/scenarios/step_forward.yaml first. The
 //   scenario defaults to the plan's "scenario" field (relative to the plan's
@@ -63,25 +64,42 @@ int main(int argc, char** argv) {
     plan = readPlan(plan_path, sc);
   }
   std::printf("plan %s: scenario %s, %zu stances\n", plan_path.c_str(), sc.name.c_str(), plan.stances.size());
-  std::printf("%3s %7s %-16s %9s %9s %7s %8s %8s %8s %8s %9s\n", "n", "verify", "result", "wall s", "posture s",
-              "calls", "repairs", "filtered", "refined", "samples", "motion s");
-  InterpolationResult keep;
-  for (int n : {10, 20})
-    for (bool verify : {true, false}) {
+  std::printf("%3s %7s %7s %-16s %9s %9s %7s %8s %8s %8s %8s %9s\n", "n", "verify", "threads", "result", "wall s",
+              "posture s", "calls", "repairs", "filtered", "refined", "samples", "motion s");
+  InterpolationResult keep, one_thread;
+  struct Variant {
+    int n;
+    bool verify;
+    int threads;
+  };
+  for (const Variant v : {Variant{10, true, 2}, Variant{20, true, 1}, Variant{20, true, 2}, Variant{20, false, 2}}) {
+    {
+      const int n = v.n;
+      const bool verify = v.verify;
       InterpolatorOptions o;
       o.steps = n;
       o.verify_samples = verify;
+      o.threads = v.threads;
       o.posture_ipopt_options = ipopt;
       o.collision_cutoff = cutoff;
       InterpolationResult r = interpolate(plan, sc, o);
       const auto& s = r.trajectory.stats;
-      std::printf("%3d %7s %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, verify ? "yes" : "no",
-                  toString(r.status), s.seconds, r.posture_seconds, s.posture_calls, s.repairs, r.filtered,
+      std::printf("%3d %7s %7d %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, verify ? "yes" : "no",
+                  v.threads, toString(r.status), s.seconds, r.posture_seconds, s.posture_calls, s.repairs, r.filtered,
                   r.refinements, r.trajectory.samples.size(), r.trajectory.duration());
       if (!r.success()) std::printf("    reason: %s\n", r.reason.c_str());
       std::fflush(stdout);
-      if (n == 20 && verify) keep = std::move(r);
+      if (n == 20 && verify && v.threads == 1) one_thread = std::move(r);
+      else if (n == 20 && verify) keep = std::move(r);
     }
+  }
+  if (keep.success() && one_thread.success()) {
+    bool same = keep.trajectory.samples.size() == one_thread.trajectory.samples.size();
+    for (std::size_t i = 0; same && i < keep.trajectory.samples.size(); ++i)
+      same = keep.trajectory.samples[i].q.joints == one_thread.trajectory.samples[i].q.joints &&
+             keep.trajectory.samples[i].q.base_position == one_thread.trajectory.samples[i].q.base_position;
+    std::printf("same trajectory on 1 and 2 threads (n = 20): %s\n", same ? "yes" : "NO");
+  }
   if (keep.success()) {
     ValidityChecker checker(sc.robot, sc.scene);
     const TrajectoryReport rep = checkTrajectory(keep.trajectory, sc, checker);

@@ -1,7 +1,12 @@
 #include "interpolator/interpolator.h"
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <mutex>
+#include <thread>
 
 #include "interpolator/stance_filter.h"
 #include "interpolator/time_law.h"
@@ -43,6 +48,7 @@ std::string validateOptions(const InterpolatorOptions& o) {
     return "the orientation tolerance in the air must be in [0, 1)";
   if (o.repair_attempts < 0 || !(o.repair_step > 0) || o.refine_depth < 0 || o.posture_iterations < 1)
     return "repair attempts, refinement depth and posture iterations must be non-negative, the repair step positive";
+  if (o.threads < 1) return "threads must be at least 1";
   return "";
 }
 
@@ -126,16 +132,59 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   tr.stats.transitions = static_cast<int>(designs.size());
   pr.transitions = tr.stats.transitions;
 
+  // Transitions depend only on their two stances: they are solved on
+  // `threads` workers, each with its own solver (posture generator and
+  // checker), and used in order, so the result is the same for any number of
+  // threads. A failure stops the workers from taking later transitions; the
+  // first failing transition in order is the one reported.
+  const std::size_t nd = designs.size();
+  std::vector<TransitionOutcome> outcomes(nd);
+  std::vector<char> done(nd, 0);
+  {
+    std::atomic<std::size_t> next{0};
+    std::atomic<std::size_t> first_failed{nd};
+    std::atomic<bool> stop{false};  // the caller's cancel, seen by any worker
+    std::mutex m;                   // progress and statistics
+    std::size_t finished = 0;
+    auto work = [&](TransitionSolver& s) {
+      for (;;) {
+        const std::size_t i = next.fetch_add(1);
+        if (i >= nd || i > first_failed.load() || stop.load()) return;
+        if (cancel && cancel->load()) {
+          stop = true;
+          return;
+        }
+        const TransitionDesign& d = designs[i];
+        auto cached = fr.solved.find({d.from, d.to});
+        TransitionOutcome o = cached != fr.solved.end() ? cached->second : s.solve(plan, d, cancel);
+        const bool counted = cached == fr.solved.end();
+        if (o.cancelled) stop = true;
+        if (!o.ok && !o.cancelled)
+          for (std::size_t f = first_failed.load(); i < f && !first_failed.compare_exchange_weak(f, i);) {
+          }
+        std::lock_guard<std::mutex> lock(m);
+        if (counted) tr.stats.posture_calls += o.posture_calls, res.posture_seconds += o.posture_seconds;
+        outcomes[i] = std::move(o);
+        done[i] = 1;
+        pr.transition = static_cast<int>(++finished);
+        report("transitions");
+      }
+    };
+    const int nthreads = std::max(1, std::min<int>(opt.threads, static_cast<int>(nd)));
+    std::vector<std::unique_ptr<TransitionSolver>> extra;
+    std::vector<std::thread> pool;
+    for (int t = 1; t < nthreads; ++t) {
+      extra.push_back(std::make_unique<TransitionSolver>(sc, to));
+      pool.emplace_back(work, std::ref(*extra.back()));
+    }
+    work(solver);
+    for (auto& th : pool) th.join();
+  }
   std::vector<MotionPiece> pieces;
-  for (std::size_t i = 0; i < designs.size(); ++i) {
+  for (std::size_t i = 0; i < nd; ++i) {
     const TransitionDesign& d = designs[i];
-    pr.transition = static_cast<int>(i);
-    report("transitions");
-    if (cancel && cancel->load()) return fail(Status::Cancelled, "cancelled");
-    auto cached = fr.solved.find({d.from, d.to});
-    TransitionOutcome o = cached != fr.solved.end() ? cached->second : solver.solve(plan, d, cancel);
-    if (cached == fr.solved.end()) tr.stats.posture_calls += o.posture_calls, res.posture_seconds += o.posture_seconds;
-    if (o.cancelled) return fail(Status::Cancelled, "cancelled");
+    if (!done[i] || outcomes[i].cancelled) return fail(Status::Cancelled, "cancelled");
+    TransitionOutcome& o = outcomes[i];
     if (!o.ok) {
       res.failed_stances = {d.from, d.to};
       const std::string where = "stances " + std::to_string(d.from) + " -> " + std::to_string(d.to) + ": ";

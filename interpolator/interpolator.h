@@ -37,6 +37,8 @@ struct InterpolatorOptions {
   int posture_iterations = 100;
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out
   std::vector<std::string> posture_ipopt_options;  // "name=value", passed to each posture solve
+  // Transitions solved at once, one solver each (same result for any count).
+  int threads = 2;
 };
 
 struct InterpolationProgress {

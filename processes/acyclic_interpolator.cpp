@@ -78,6 +78,9 @@ int main(int argc, char** argv) {
   app.add_option("--lift", o.lift, "straight motion along the surface normal on leaving and reaching, m")
       ->capture_default_str();
   app.add_flag("--no-filter", no_filter, "keep every stance of the plan");
+  app.add_option("--threads", o.threads, "transitions solved at once (the result does not depend on it)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   CLI11_PARSE(app, argc, argv);
   o.filter = !no_filter;

@@ -324,16 +324,27 @@ TEST(Interpolator, SingleFootStepOnTheFloor) {
   EXPECT_EQ(tr.samples.back().dq.norm(), 0.0);
 }
 
-TEST(Interpolator, SameInputSameOutput) {
+TEST(Interpolator, SameInputSameOutputOnAnyNumberOfThreads) {
+  // Transitions are solved on worker threads and used in order: one thread,
+  // two threads and a repeat give the same samples bit for bit.
   const Scenario& sc = floorScenario();
   const Plan plan = stepPlan(sc, 0.15);
   InterpolatorOptions opt;
   opt.steps = 8;
-  const InterpolationResult a = interpolate(plan, sc, opt), b = interpolate(plan, sc, opt);
-  ASSERT_TRUE(a.success() && b.success());
-  ASSERT_EQ(a.trajectory.samples.size(), b.trajectory.samples.size());
-  for (std::size_t i = 0; i < a.trajectory.samples.size(); ++i)
-    ASSERT_EQ(a.trajectory.samples[i].q.joints, b.trajectory.samples[i].q.joints) << i;
+  opt.threads = 1;
+  const InterpolationResult a = interpolate(plan, sc, opt);
+  opt.threads = 2;
+  const InterpolationResult b = interpolate(plan, sc, opt), c = interpolate(plan, sc, opt);
+  ASSERT_TRUE(a.success() && b.success() && c.success());
+  EXPECT_EQ(a.trajectory.stats.posture_calls, b.trajectory.stats.posture_calls);
+  for (const InterpolationResult* r : {&b, &c}) {
+    ASSERT_EQ(a.trajectory.samples.size(), r->trajectory.samples.size());
+    ASSERT_EQ(a.trajectory.phases.size(), r->trajectory.phases.size());
+    for (std::size_t i = 0; i < a.trajectory.samples.size(); ++i) {
+      ASSERT_EQ(a.trajectory.samples[i].q.joints, r->trajectory.samples[i].q.joints) << i;
+      ASSERT_EQ(a.trajectory.samples[i].q.base_position, r->trajectory.samples[i].q.base_position) << i;
+    }
+  }
 }
 
 TEST(Interpolator, HandReachesTheTableAndLeavesIt) {
@@ -506,6 +517,11 @@ TEST(Interpolator, BadInputAndCancellation) {
   InterpolatorOptions opt;
   opt.dt = 0;
   EXPECT_EQ(interpolate(plan, sc, opt).status, InterpolationResult::Status::InvalidInput);
+  InterpolatorOptions no_threads;
+  no_threads.threads = 0;
+  const InterpolationResult t = interpolate(plan, sc, no_threads);
+  EXPECT_EQ(t.status, InterpolationResult::Status::InvalidInput);
+  EXPECT_NE(t.reason.find("threads"), std::string::npos) << t.reason;
   // A witness that breaks the contract: the foot below the floor.
   Plan sunk = plan;
   sunk.stances[2].configuration.base_position.z() -= 0.05;
