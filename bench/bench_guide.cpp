@@ -9,11 +9,13 @@
 #include <vector>
 
 #include "planner/guide/guide_author.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/search/planner_parameters.h"
 
 using namespace acyclic;
 
 int main(int argc, char** argv) {
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::vector<std::string> paths;
   int seeds = 5;
   double max_seconds = -1;

@@ -11,7 +11,6 @@
 //   folder, the current directory or the source tree).
 #include <cstdio>
 #include <cstdlib>
-#include <malloc.h>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,16 +18,14 @@
 #include <nlohmann/json.hpp>
 
 #include "interpolator/interpolator.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/check/trajectory_check.h"
 #include "planner/search/planner_parameters.h"
 
 using namespace acyclic;
 
 int main(int argc, char** argv) {
-  // As acyclic-interpolator does: MUMPS's workspace stays in the heap between factorizations.
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
-  mallopt(M_TOP_PAD, 64 << 20);
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   // Positional: plan, scenario; --ipopt name=value (repeatable) and --cutoff M for tuning.
   std::vector<std::string> ipopt, positional;
   double cutoff = InterpolatorOptions{}.collision_cutoff;

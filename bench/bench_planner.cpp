@@ -6,10 +6,12 @@
 #include <string>
 
 #include "planner/search/planner_parameters.h"
+#include "planner/posture/heap_tuning.h"
 
 using namespace acyclic;
 
 int main(int argc, char** argv) {
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::string path = ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml";
   double max_seconds = -1;
   for (int i = 1; i < argc; ++i) {

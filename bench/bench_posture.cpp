@@ -11,6 +11,7 @@
 #include <random>
 
 #include "planner/check/validity.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/posture/posture_generator.h"
 
 using namespace acyclic;
@@ -87,6 +88,7 @@ std::vector<Problem> makeProblems(const Scenario& sc, int n, unsigned seed) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   int n = 100;
   unsigned seed = 1;
   PostureGeneratorOptions opt;

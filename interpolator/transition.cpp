@@ -147,6 +147,11 @@ TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options
     : sc_(sc), opt_(std::move(options)), generator_(sc.robot, sc.scene, opt_.posture), checker_(sc.robot, sc.scene),
       kin_(sc.robot) {
   if (opt_.steps < 1) throw std::invalid_argument("steps must be at least 1");
+  // Thousands of checks in sequence, for their verdict only: pairs that
+  // cannot be within 2 cm are not measured, and the equilibrium LPs start
+  // from the previous check's basis (validity.h).
+  checker_.setClearanceCutoff(0.02);
+  checker_.setWarmStart(true);
 }
 
 namespace {

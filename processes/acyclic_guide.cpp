@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "planner/common/format_error.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/guide/guide_author.h"
 #include "processes/guide_service.h"
 #include "processes/lcm_process.h"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   proc::installSignalHandlers();
   if (lcm_mode) return serveGuide(url, o);
   if (in.empty() || out.empty()) {

@@ -8,13 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include <csignal>
-#include <malloc.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
 
 #include "interpolator/interpolator.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/common/format_error.h"
 #include "processes/lcm_process.h"
 #include "processes/interpolator_service.h"
@@ -84,12 +84,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   CLI11_PARSE(app, argc, argv);
   o.filter = !no_filter;
-  // MUMPS allocates and frees its workspace on every factorization, and
-  // glibc hands such blocks back to the kernel each time: keep them in the
-  // heap (measured: a fifth of the wall time went to page faults).
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
-  mallopt(M_TOP_PAD, 64 << 20);
+  acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   if (lcm_mode) {
     if (!in.empty() || !out.empty()) {
       std::fprintf(stderr, "acyclic-interpolator: --lcm and --in/--out exclude each other\n");

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "planner/common/format_error.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/plan/guide.h"
 #include "planner/search/planner_parameters.h"
 #include "processes/lcm_process.h"
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   CLI11_PARSE(app, argc, argv);
+  acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
 
   acyclic::proc::installSignalHandlers();
   if (lcm_mode) {

@@ -11,6 +11,7 @@
 
 #include "planner/check/validity.h"
 #include "planner/common/format_error.h"
+#include "planner/posture/heap_tuning.h"
 #include "planner/plan/plan.h"
 #include "planner/posture/posture_generator.h"
 #include "planner/search/search_volume.h"
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
                  "write the witness as a one-stance plan (acyclic.plan/1) with the stance once the change settles "
                  "(removed contacts gone, the added one supporting): the input of a next --from");
   CLI11_PARSE(app, argc, argv);
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   try {
     const Scenario sc = Scenario::load(scenario_path);
     PostureRequest r;

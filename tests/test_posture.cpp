@@ -9,7 +9,9 @@
 #include <set>
 #include <thread>
 
+#include "planner/check/quasi_static.h"
 #include "planner/check/validity.h"
+#include "planner/plan/plan.h"
 #include "planner/posture/posture_generator.h"
 #include "test_support.h"
 
@@ -528,4 +530,48 @@ TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
   r.initial_guess = perturbed(sc.start, rng, 0.05, 0.02);
   PostureGenerator pg(sc.robot, sc.scene);
   EXPECT_TRUE(pg.solve(r).success());
+}
+
+// The independent check restarts each LP from the previous call's basis. Along
+// every stance of the chair plan, walked in small steps toward the next
+// witness (as the trajectory check walks samples), and with supports that
+// cannot hold the robot mixed in, one checker kept warm must give the same
+// verdicts, margins and torque ratios as a fresh checker for each call.
+TEST(QuasiStaticCheck, WarmStartedChecksAgreeWithColdOnes) {
+  const Scenario& sc = chair();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
+  QuasiStaticChecker warm(sc.robot, sc.scene);
+  warm.setWarmStart(true);
+  Kinematics k(sc.robot);
+  int checks = 0, infeasible = 0;
+  auto compare = [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
+    k.setConfiguration(q);
+    const QuasiStaticReport a = warm.check(k, stance);
+    const QuasiStaticReport b = QuasiStaticChecker(sc.robot, sc.scene).check(k, stance);
+    ++checks;
+    infeasible += !b.feasible;
+    ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
+    if (std::isfinite(b.margin)) EXPECT_NEAR(a.margin, b.margin, 1e-6 * (1 + std::abs(b.margin))) << checks;
+    if (b.feasible) EXPECT_NEAR(a.worst_torque_ratio, b.worst_torque_ratio, 1e-5) << checks;  // Clp's tolerances
+  };
+  for (std::size_t i = 0; i + 1 < plan.stances.size(); i += 3) {
+    const auto stance = plan.stances[i].specs();
+    const Configuration& q0 = plan.stances[i].configuration;
+    const Configuration& q1 = plan.stances[i + 1].configuration;
+    for (double t : {0.0, 0.02, 0.04}) {
+      Configuration q = q0;
+      q.base_position = (1 - t) * q0.base_position + t * q1.base_position;
+      q.joints = (1 - t) * q0.joints + t * q1.joints;
+      compare(q, stance);
+    }
+    // Only the first supporting contact of the stance holds the robot.
+    auto one = stance;
+    bool first = true;
+    for (auto& c : one)
+      if (c.supporting) c.supporting = first, first = false;
+    compare(q0, one);
+    compare(q0, stance);
+  }
+  EXPECT_GT(checks, 100);
+  EXPECT_GT(infeasible, 5);  // the single supports
 }

@@ -26,16 +26,40 @@ struct Lp {
       if (std::abs(a) > 1e-12) ri.push_back(r), ci.push_back(c), v.push_back(a);
     rlo.push_back(lo), rhi.push_back(hi);
   }
-  // Minimizes obj; returns false when infeasible (or failed).
-  bool solve(std::vector<double>& x) const {
+  // Minimizes obj; returns false when infeasible (or failed). With `warm`:
+  // starts from its basis when the LP has the same size, and keeps the
+  // optimal basis found.
+  bool solve(std::vector<double>& x, QuasiStaticChecker::WarmStart* warm) const {
+    const int nrows = static_cast<int>(rlo.size());
     CoinPackedMatrix M(false, ri.data(), ci.data(), v.data(), static_cast<CoinBigIndex>(v.size()));
-    M.setDimensions(static_cast<int>(rlo.size()), ncols);
+    M.setDimensions(nrows, ncols);
     ClpSimplex model;
     model.setLogLevel(0);
     model.loadProblem(M, clo.data(), chi.data(), obj.data(), rlo.data(), rhi.data());
-    model.initialSolve();
+    const bool warmed = warm && warm->rows == nrows && warm->cols == ncols;
+    if (!warmed) {
+      model.initialSolve();  // presolve, then Clp's choice of method
+      return finish(model, x, warm);
+    }
+    model.copyinStatus(warm->status.data());
+    model.dual();  // from the given basis (a presolve would drop it)
+    if (!model.isProvenOptimal()) {  // a stale basis must never change the verdict
+      ClpSimplex cold;
+      cold.setLogLevel(0);
+      cold.loadProblem(M, clo.data(), chi.data(), obj.data(), rlo.data(), rhi.data());
+      cold.initialSolve();
+      return finish(cold, x, warm);
+    }
+    return finish(model, x, warm);
+  }
+  bool finish(ClpSimplex& model, std::vector<double>& x, QuasiStaticChecker::WarmStart* warm) const {
     if (!model.isProvenOptimal()) return false;
     x.assign(model.getColSolution(), model.getColSolution() + ncols);
+    if (warm) {
+      warm->rows = model.numberRows();
+      warm->cols = ncols;
+      warm->status.assign(model.statusArray(), model.statusArray() + model.numberRows() + ncols);
+    }
     return true;
   }
 };
@@ -132,10 +156,14 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
 
   // LP 2 first: forces in their pyramids that balance gravity, with the
   // smallest worst torque ratio; infeasible only when no forces balance at all.
+  std::unique_lock<std::mutex> warm_lock(warm_mutex_, std::defer_lock);
+  if (warm_start_) warm_lock.try_lock();
+  WarmStart* warm2 = warm_lock.owns_lock() ? &warm_[1] : nullptr;
+  WarmStart* warm1 = warm_lock.owns_lock() ? &warm_[0] : nullptr;
   Lp lp2;
   const int t_col = build(lp2, false);
   std::vector<double> x2;
-  if (!lp2.solve(x2)) {
+  if (!lp2.solve(x2, warm2)) {
     rep.reason = "no contact forces inside the friction pyramids balance gravity (the centre of mass is outside the support)";
     return rep;
   }
@@ -144,7 +172,7 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
   Lp lp1;
   const int s_col = build(lp1, true);
   std::vector<double> x1;
-  rep.margin = lp1.solve(x1) ? x1[s_col] : -std::numeric_limits<double>::infinity();
+  rep.margin = lp1.solve(x1, warm1) ? x1[s_col] : -std::numeric_limits<double>::infinity();
 
   // Forces, torques and the balance residual at LP 2's solution.
   Eigen::VectorXd JTf = Eigen::VectorXd::Zero(nt);

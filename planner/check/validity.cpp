@@ -129,7 +129,9 @@ CheckPart ValidityChecker::checkCollisions(const std::vector<ContactSpec>& stanc
   std::set<std::pair<int, int>> touching;
   for (const auto& c : stance)
     touching.insert({robot_->spots()[c.spot].link, scene_->surfaces()[c.surface].obstacle});
-  const auto ds = collision_.distances(kin_);
+  DistanceOptions dopt;
+  dopt.cutoff = clearance_cutoff_;
+  const auto ds = collision_.distances(kin_, dopt);
   double worst_free = std::numeric_limits<double>::infinity();
   std::string worst_name;
   int n_touch = 0;
@@ -151,7 +153,10 @@ CheckPart ValidityChecker::checkCollisions(const std::vector<ContactSpec>& stanc
   }
   std::ostringstream os;
   os << collision_.numRobotEnvironmentPairs() << " robot-environment and " << collision_.numSelfPairs()
-     << " self pairs; smallest clearance " << fmt("%.1f", worst_free * 1e3) << " mm (" << worst_name << "); "
+     << " self pairs; smallest clearance "
+     << (std::isfinite(worst_free) ? fmt("%.1f", worst_free * 1e3) + " mm (" + worst_name + ")"
+                                   : fmt("over %.0f mm", clearance_cutoff_ * 1e3))
+     << "; "
      << n_touch << " contacting pairs, deepest " << fmt("%.3f", std::max(0.0, worst_pen) * 1e3) << " mm";
   p.summary = os.str();
   return p;

@@ -4,6 +4,7 @@
 // and every violation with its figure.
 //
 // Equilibrium is checked by the independent quasi-static LP (quasi_static.h).
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,16 @@ class ValidityChecker {
   CheckPart checkEquilibrium(const std::vector<ContactSpec>& stance,
                              QuasiStaticReport* report = nullptr);  // idem
 
+  // Pairs whose bounding spheres are farther apart than `m` cannot collide
+  // and are not measured: the verdict is the same, the summary's smallest
+  // clearance is then over the pairs measured. Infinite by default (every
+  // pair measured, as acyclic-check reports); a caller that checks thousands
+  // of postures for their verdict (the interpolator) sets a few centimetres.
+  void setClearanceCutoff(double m) { clearance_cutoff_ = m; }
+  // The equilibrium LPs warm-started (QuasiStaticChecker::setWarmStart): same
+  // verdicts, faster along a trajectory.
+  void setWarmStart(bool on) { statics_.setWarmStart(on); }
+
  private:
   std::shared_ptr<const RobotModel> robot_;
   std::shared_ptr<const Scene> scene_;
@@ -57,6 +68,7 @@ class ValidityChecker {
   Kinematics kin_;
   CollisionModel collision_;
   QuasiStaticChecker statics_;
+  double clearance_cutoff_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace acyclic
