@@ -491,7 +491,11 @@ TEST(PostureGenerator, TwoGeneratorsOnTwoThreadsAgreeWithOne) {
     reqs.push_back(r);
   }
   auto run = [&](std::vector<Eigen::VectorXd>& out) {
-    PostureGenerator pg(sc.robot, sc.scene);
+    // Bounded by iterations, not time: Ipopt's CPU time is the process's,
+    // both threads' together, and a loaded machine must not change a result.
+    PostureGeneratorOptions o;
+    o.max_seconds = 1e6;
+    PostureGenerator pg(sc.robot, sc.scene, o);
     for (const auto& r : reqs) {
       const PostureResult res = pg.solve(r);
       EXPECT_TRUE(res.success()) << res.reason;
