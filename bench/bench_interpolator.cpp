@@ -70,25 +70,23 @@ int main(int argc, char** argv) {
     int threads;
   };
   for (const Variant v : {Variant{10, true, 2}, Variant{20, true, 1}, Variant{20, true, 2}, Variant{20, false, 2}}) {
-    {
-      const int n = v.n;
-      const bool verify = v.verify;
-      InterpolatorOptions o;
-      o.steps = n;
-      o.verify_samples = verify;
-      o.threads = v.threads;
-      o.posture_ipopt_options = ipopt;
-      o.collision_cutoff = cutoff;
-      InterpolationResult r = interpolate(plan, sc, o);
-      const auto& s = r.trajectory.stats;
-      std::printf("%3d %7s %7d %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, verify ? "yes" : "no",
-                  v.threads, toString(r.status), s.seconds, r.posture_seconds, s.posture_calls, s.repairs, r.filtered,
-                  r.refinements, r.trajectory.samples.size(), r.trajectory.duration());
-      if (!r.success()) std::printf("    reason: %s\n", r.reason.c_str());
-      std::fflush(stdout);
-      if (n == 20 && verify && v.threads == 1) one_thread = std::move(r);
-      else if (n == 20 && verify) keep = std::move(r);
-    }
+    const int n = v.n;
+    const bool verify = v.verify;
+    InterpolatorOptions o;
+    o.steps = n;
+    o.verify_samples = verify;
+    o.threads = v.threads;
+    o.posture_ipopt_options = ipopt;
+    o.collision_cutoff = cutoff;
+    InterpolationResult r = interpolate(plan, sc, o);
+    const auto& s = r.trajectory.stats;
+    std::printf("%3d %7s %7d %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, verify ? "yes" : "no",
+                v.threads, toString(r.status), s.seconds, r.posture_seconds, s.posture_calls, s.repairs, r.filtered,
+                r.refinements, r.trajectory.samples.size(), r.trajectory.duration());
+    if (!r.success()) std::printf("    reason: %s\n", r.reason.c_str());
+    std::fflush(stdout);
+    if (n == 20 && verify && v.threads == 1) one_thread = std::move(r);
+    else if (n == 20 && verify) keep = std::move(r);
   }
   if (keep.success() && one_thread.success()) {
     bool same = keep.trajectory.samples.size() == one_thread.trajectory.samples.size();

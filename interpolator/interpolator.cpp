@@ -159,9 +159,11 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
         TransitionOutcome o = cached != fr.solved.end() ? cached->second : s.solve(plan, d, cancel);
         const bool counted = cached == fr.solved.end();
         if (o.cancelled) stop = true;
-        if (!o.ok && !o.cancelled)
-          for (std::size_t f = first_failed.load(); i < f && !first_failed.compare_exchange_weak(f, i);) {
+        if (!o.ok && !o.cancelled) {  // first_failed = min(first_failed, i)
+          std::size_t f = first_failed.load();
+          while (i < f && !first_failed.compare_exchange_weak(f, i)) {
           }
+        }
         std::lock_guard<std::mutex> lock(m);
         if (counted) tr.stats.posture_calls += o.posture_calls, res.posture_seconds += o.posture_seconds;
         outcomes[i] = std::move(o);

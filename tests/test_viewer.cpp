@@ -257,6 +257,19 @@ std::string chromiumMissing() {
   return chromiumPath() + " not found: the browser test needs Debian's chromium (scripts/install-deps installs it)";
 }
 
+// Opens the page in headless Chromium at `query`, visits every stance, and
+// returns snap.mjs's state file (null, with a failure recorded, if it fails).
+nlohmann::json browserVisit(const std::string& page, const std::string& query, const std::string& dir) {
+  const std::string state_path = dir + "/state.json";
+  const auto r = runProcess("node " + sourcePath("viewer/tools/snap.mjs") + " " + page + " --query '" + query +
+                            "' --width 480 --height 320 --visit-stances --state " + state_path);
+  if (r.status != 0) {
+    ADD_FAILURE() << r.output;
+    return nullptr;
+  }
+  return nlohmann::json::parse(readFile(state_path));
+}
+
 TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
   ASSERT_TRUE(haveChromium()) << chromiumMissing();
   TempDir out;
@@ -264,11 +277,8 @@ TEST_F(Viewer, PageInHeadlessChromiumLoadsTheRobotEveryStanceAndFrameOffline) {
   auto r = runProcess(binaryPath("processes/acyclic-view") + " --scenario " + sourcePath(kScenario) + " --plan " +
                       plan_path_ + " --trajectory " + trajectory_path_ + " --out " + page);
   ASSERT_EQ(r.status, 0) << r.output;
-  const std::string state_path = out.path() + "/state.json";
-  r = runProcess("node " + sourcePath("viewer/tools/snap.mjs") + " " + page + " --query 't=2.0' --width 480 --height 320 --visit-stances --state " +
-                 state_path);
-  ASSERT_EQ(r.status, 0) << r.output;
-  const auto j = nlohmann::json::parse(readFile(state_path));
+  const auto j = browserVisit(page, "t=2.0", out.path());
+  ASSERT_FALSE(j.is_null());
   const auto& st = j.at("state");
   EXPECT_TRUE(st.at("loaded").get<bool>());
   EXPECT_TRUE(st.at("error").is_null()) << st.at("error");
@@ -320,11 +330,8 @@ TEST(ViewerChair, TheWholeChairPlanInHeadlessChromium) {
                       sourcePath("models/scenarios/chair_table.yaml") + " --plan " +
                       sourcePath("tests/data/chair.plan.json") + " --out " + page);
   ASSERT_EQ(r.status, 0) << r.output;
-  const std::string state_path = out.path() + "/state.json";
-  r = runProcess("node " + sourcePath("viewer/tools/snap.mjs") + " " + page +
-                 " --query 'stance=0' --width 480 --height 320 --visit-stances --state " + state_path);
-  ASSERT_EQ(r.status, 0) << r.output;
-  const auto j = nlohmann::json::parse(readFile(state_path));
+  const auto j = browserVisit(page, "stance=0", out.path());
+  ASSERT_FALSE(j.is_null());
   const auto& st = j.at("state");
   EXPECT_TRUE(st.at("loaded").get<bool>());
   EXPECT_TRUE(st.at("error").is_null()) << st.at("error");

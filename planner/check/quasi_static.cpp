@@ -33,32 +33,30 @@ struct Lp {
     const int nrows = static_cast<int>(rlo.size());
     CoinPackedMatrix M(false, ri.data(), ci.data(), v.data(), static_cast<CoinBigIndex>(v.size()));
     M.setDimensions(nrows, ncols);
+    auto load = [&](ClpSimplex& model) {
+      model.setLogLevel(0);
+      model.loadProblem(M, clo.data(), chi.data(), obj.data(), rlo.data(), rhi.data());
+    };
+    if (warm && warm->rows == nrows && warm->cols == ncols) {
+      ClpSimplex model;
+      load(model);
+      model.copyinStatus(warm->status.data());
+      model.dual();  // from the given basis (a presolve would drop it)
+      if (model.isProvenOptimal()) return finish(model, x, warm);
+      // a stale basis must never change the verdict: solved again from scratch
+    }
     ClpSimplex model;
-    model.setLogLevel(0);
-    model.loadProblem(M, clo.data(), chi.data(), obj.data(), rlo.data(), rhi.data());
-    const bool warmed = warm && warm->rows == nrows && warm->cols == ncols;
-    if (!warmed) {
-      model.initialSolve();  // presolve, then Clp's choice of method
-      return finish(model, x, warm);
-    }
-    model.copyinStatus(warm->status.data());
-    model.dual();  // from the given basis (a presolve would drop it)
-    if (!model.isProvenOptimal()) {  // a stale basis must never change the verdict
-      ClpSimplex cold;
-      cold.setLogLevel(0);
-      cold.loadProblem(M, clo.data(), chi.data(), obj.data(), rlo.data(), rhi.data());
-      cold.initialSolve();
-      return finish(cold, x, warm);
-    }
+    load(model);
+    model.initialSolve();  // presolve, then Clp's choice of method
     return finish(model, x, warm);
   }
   bool finish(ClpSimplex& model, std::vector<double>& x, QuasiStaticChecker::WarmStart* warm) const {
     if (!model.isProvenOptimal()) return false;
     x.assign(model.getColSolution(), model.getColSolution() + ncols);
     if (warm) {
-      warm->rows = model.numberRows();
+      warm->rows = static_cast<int>(rlo.size());
       warm->cols = ncols;
-      warm->status.assign(model.statusArray(), model.statusArray() + model.numberRows() + ncols);
+      warm->status.assign(model.statusArray(), model.statusArray() + warm->rows + ncols);
     }
     return true;
   }
