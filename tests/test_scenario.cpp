@@ -60,9 +60,9 @@ TEST(ChairScenario, MatchesThePaper) {
   // The goal lies beyond the side of the table and the start does not meet it.
   Kinematics k(sc.robot);
   k.setConfiguration(sc.start);
-  EXPECT_FALSE(sc.goal.satisfied(k));
+  EXPECT_FALSE(sc.goal.linkWithinBounds(k));
   k.setConfiguration(sc.key_postures.back());
-  EXPECT_TRUE(sc.goal.satisfied(k));
+  EXPECT_TRUE(sc.goal.linkWithinBounds(k));
   const auto& table = sc.scene->surfaces()[sc.scene->surfaceIndex("table_top")];
   double table_y_max = -1e9;
   for (const auto& v : table.polygon.vertices()) table_y_max = std::max(table_y_max, (table.frame * Eigen::Vector3d(v.x(), v.y(), 0)).y());
@@ -100,6 +100,31 @@ TEST(ScenarioFiles, StartPlacementComesFromTheConfiguration) {
   EXPECT_NEAR(sc.start_stance[1].placement.theta, M_PI / 2, 1e-12);
 }
 
+// A goal with supported_by holds only for a stance in which each listed spot
+// touches and supports: the link bound alone does not meet it.
+TEST(ScenarioFiles, GoalSupportedByNeedsEachSpotSupporting) {
+  test::TempDir dir;
+  const Scenario sc = Scenario::load(
+      dir.write("goal.yaml", scenarioText("", "{link: WAIST, axis: z, max: 5, supported_by: [r_sole, l_sole]}")));
+  ASSERT_EQ(sc.goal.supporting_spots.size(), 2u);
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  ASSERT_TRUE(sc.goal.linkWithinBounds(k));
+  const ContactSpec r = sc.start_stance[0];
+  ContactSpec l = r;
+  l.spot = sc.robot->spotIndex("l_sole");
+  EXPECT_FALSE(sc.goal.satisfied(k, {r}));  // l_sole not in the stance
+  l.supporting = false;
+  EXPECT_FALSE(sc.goal.satisfied(k, {r, l}));  // in it, geometric only
+  l.supporting = true;
+  EXPECT_TRUE(sc.goal.satisfied(k, {r, l}));
+  EXPECT_NE(sc.goal.describe(*sc.robot).find("supported by r_sole and l_sole"), std::string::npos)
+      << sc.goal.describe(*sc.robot);
+  // Without supported_by the link bound is the whole goal.
+  const Scenario plain = Scenario::load(dir.write("plain.yaml", scenarioText("", "{link: WAIST, axis: z, max: 5}")));
+  EXPECT_TRUE(plain.goal.satisfied(k, {}));
+}
+
 TEST(ScenarioFiles, BadFieldsAreNamed) {
   expectFormatError(scenarioText() + "seed: -3\n", "seed", "non-negative");
   expectFormatError(scenarioText("    - {spot: r_foot, surface: floor}\n"), "start.contacts[1].spot", "r_sole");
@@ -108,6 +133,13 @@ TEST(ScenarioFiles, BadFieldsAreNamed) {
   expectFormatError(scenarioText("", "{link: WAIST, axis: w, min: 1}"), "goal.axis", "x, y, z");
   expectFormatError(scenarioText("", "{link: WAIST, axis: y}"), "goal", "min, max");
   expectFormatError(scenarioText("", "{link: NECK, axis: y, min: 1}"), "goal.link", "link");
+  expectFormatError(scenarioText("", "{link: WAIST, axis: y, min: 1, supported_by: [r_foot]}"), "goal.supported_by[0]",
+                    "r_sole");
+  expectFormatError(scenarioText("", "{link: WAIST, axis: y, min: 1, supported_by: [r_sole, r_sole]}"),
+                    "goal.supported_by[1]", "not already listed");
+  expectFormatError(scenarioText("", "{link: WAIST, axis: y, min: 1, supported_by: [r_sole]}") +
+                        "allowed_spots: [l_sole]\n",
+                    "goal.supported_by[0]", "allowed_spots");
   expectFormatError(scenarioText() + "unexpected: 1\n", "unexpected", "unknown field");
   std::string wrong_format = scenarioText();
   wrong_format.replace(wrong_format.find("/1"), 2, "/9");

@@ -25,7 +25,7 @@ PlanReport checkPlan(const Plan& plan, const Scenario& sc, ValidityChecker& chec
                                       " missing, " + std::to_string(first.flipped) + " with another support)");
   Kinematics k(sc.robot);
   k.setConfiguration(plan.stances.back().configuration);
-  if (!sc.goal.satisfied(k))
+  if (!sc.goal.satisfied(k, plan.stances.back().specs()))
     rep.sequence_violations.push_back("the last stance does not meet the goal (" + sc.goal.describe(*sc.robot) + ")");
   for (std::size_t i = 1; i < plan.stances.size(); ++i) {
     const std::string why = checkStep(plan.stances[i - 1], plan.stances[i], sc);

@@ -161,7 +161,7 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
     if (!res.success()) continue;
     if (!checker.checkPosture(res.configuration, r.contacts).valid()) continue;
     kin.setConfiguration(res.configuration);
-    if (!g.satisfied(kin)) continue;
+    if (!g.linkWithinBounds(kin)) continue;
     out = res.configuration;
     return true;
   }

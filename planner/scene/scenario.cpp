@@ -1,5 +1,6 @@
 #include "planner/scene/scenario.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -11,9 +12,17 @@
 namespace acyclic {
 namespace fs = std::filesystem;
 
-bool GoalCondition::satisfied(const Kinematics& k) const {
+bool GoalCondition::linkWithinBounds(const Kinematics& k) const {
   const double v = k.linkPose(link).translation()[axis];
   return v >= min && v <= max;
+}
+
+bool GoalCondition::satisfied(const Kinematics& k, const std::vector<ContactSpec>& stance) const {
+  for (int spot : supporting_spots) {
+    auto it = std::find_if(stance.begin(), stance.end(), [&](const ContactSpec& c) { return c.spot == spot; });
+    if (it == stance.end() || !it->supporting) return false;
+  }
+  return linkWithinBounds(k);
 }
 
 std::string GoalCondition::describe(const RobotModel& m) const {
@@ -22,6 +31,8 @@ std::string GoalCondition::describe(const RobotModel& m) const {
   if (std::isfinite(min)) os << " >= " << min;
   if (std::isfinite(min) && std::isfinite(max)) os << " and";
   if (std::isfinite(max)) os << " <= " << max;
+  for (std::size_t i = 0; i < supporting_spots.size(); ++i)
+    os << (i == 0 ? ", supported by " : " and ") << m.spots()[supporting_spots[i]].name;
   return os.str();
 }
 
@@ -115,7 +126,7 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   }
 
   YamlField goal = root["goal"];
-  goal.allowOnly({"link", "axis", "min", "max"});
+  goal.allowOnly({"link", "axis", "min", "max", "supported_by"});
   sc.goal.link = sc.robot->linkIndex(goal["link"].string());
   if (sc.goal.link < 0) goal["link"].fail("a link of the robot");
   const std::string axis = goal["axis"].string();
@@ -125,6 +136,18 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   if (goal.has("min")) sc.goal.min = goal["min"].number();
   if (goal.has("max")) sc.goal.max = goal["max"].number();
   if (sc.goal.min > sc.goal.max) goal.fail("min <= max");
+  if (goal.has("supported_by")) {
+    YamlField a = goal["supported_by"];
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const int spot = spotOf(a.at(i));
+      if (std::find(sc.goal.supporting_spots.begin(), sc.goal.supporting_spots.end(), spot) !=
+          sc.goal.supporting_spots.end())
+        a.at(i).fail("a spot not already listed");
+      if (std::find(sc.allowed_spots.begin(), sc.allowed_spots.end(), spot) == sc.allowed_spots.end())
+        a.at(i).fail("one of allowed_spots");
+      sc.goal.supporting_spots.push_back(spot);
+    }
+  }
 
   if (root.has("key_postures")) {
     YamlField kp = root["key_postures"];

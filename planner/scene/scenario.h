@@ -25,13 +25,19 @@ struct ContactSpec {
 };
 
 // The goal: a coordinate of a link's origin within bounds (paper, 3.1: "a
-// coordinate the waist must exceed").
+// coordinate the waist must exceed"), and optionally spots that must support
+// the goal stance (without them a robot that may lean on its hands can meet a
+// waist bound by hanging on them, its feet in the air).
 struct GoalCondition {
   int link = 0;
   int axis = 0;  // 0 x, 1 y, 2 z
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
-  bool satisfied(const Kinematics& k) const;
+  std::vector<int> supporting_spots;  // each in contact and supporting in the goal stance
+  // The link bound alone, for a posture without a stance (a guide's last key posture).
+  bool linkWithinBounds(const Kinematics& k) const;
+  // The whole goal, for the witness k of a stance.
+  bool satisfied(const Kinematics& k, const std::vector<ContactSpec>& stance) const;
   std::string describe(const RobotModel& m) const;
 };
 

@@ -225,6 +225,16 @@ struct ContactPlanner::Impl {
     p.trace(line);
   }
 
+  // The goal holds at the node's transition stance, or, for an addition, at
+  // the stance where it settles (the new contact supporting too: the same
+  // witness, valid, since a support more only widens the forces that balance
+  // it); a goal that names supporting spots is often met only there.
+  // Leaves kin at n.q.
+  bool meetsGoal(const Node& n) {
+    kin.setConfiguration(n.q);
+    return sc.goal.satisfied(kin, n.transition) || (n.change == Change::Added && sc.goal.satisfied(kin, n.contacts));
+  }
+
   // Adds a son if its witness passes the independent check and no node is too
   // close to it; returns its index or -1. Its key is computed here unless given.
   int addNode(Node n, bool key_given = false) {
@@ -239,7 +249,7 @@ struct ContactPlanner::Impl {
     else kin.setConfiguration(n.q);
     nodes.push_back(std::move(n));
     const int id = static_cast<int>(nodes.size()) - 1;
-    if (sc.goal.satisfied(kin) && goal_node < 0) goal_node = id;
+    if (goal_node < 0 && meetsGoal(nodes[id])) goal_node = id;
     // The open list's order: f_T, plus (when set) a cost per contact change
     // from the start, which lifts plateaus of equal f_T (weighted A*).
     open.push({nodes[id].key + p.depth_weight * nodes[id].depth, order++, id});
@@ -567,6 +577,10 @@ struct ContactPlanner::Impl {
       }
       push(cur.transition, cur.q);
     }
+    // A goal met where the last addition settles ends on that stance.
+    const Node& end = nodes[path.back()];
+    kin.setConfiguration(end.q);
+    if (!sc.goal.satisfied(kin, end.transition)) push(end.contacts, end.q);
     plan.stats.nodes_generated = stats.nodes_generated;
     plan.stats.nodes_expanded = stats.nodes_expanded;
     plan.stats.posture_calls = stats.posture_calls;
