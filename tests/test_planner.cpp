@@ -99,6 +99,51 @@ TEST(ContactPlanner, CancelledFromAnotherThread) {
   EXPECT_LT(r.stats.seconds, 2.5);  // stops at the next posture call's end, not at the budget
 }
 
+// A goal with supported_by ends on a stance where those spots support: the
+// feet's last step is followed by the stance where it settles, if the goal is
+// met there first.
+TEST(ContactPlanner, GoalSupportedByEndsOnTheseSpotsSupporting) {
+  test::TempDir dir;
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  const std::string goal = "goal: {link: WAIST, axis: x, min: 0.25}";
+  ASSERT_NE(text.find(goal), std::string::npos);
+  text.replace(text.find(goal), goal.size(), "goal: {link: WAIST, axis: x, min: 0.25, supported_by: [r_sole, l_sole]}");
+  const Scenario sc = Scenario::load(dir.write("s.yaml", text));
+  const PlanningResult r = ContactPlanner(sc).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);  // the goal, supports included, is met by the last stance
+  int supporting_soles = 0;
+  for (const auto& c : r.plan.stances.back().contacts) supporting_soles += c.spec.supporting;
+  EXPECT_EQ(supporting_soles, 2);
+  EXPECT_EQ(r.plan.stances.back().contacts.size(), 2u);
+  // Without supported_by the same search ends one stance earlier, on the
+  // last foot touching but not yet supporting.
+  const PlanningResult plain = ContactPlanner(step()).plan();
+  ASSERT_TRUE(plain.solved());
+  ASSERT_EQ(plain.plan.stances.size() + 1, r.plan.stances.size());
+  int plain_supporting = 0;
+  for (const auto& c : plain.plan.stances.back().contacts) plain_supporting += c.spec.supporting;
+  EXPECT_EQ(plain_supporting, 1);
+}
+
+// The small scenario with non-foot contacts: HRP-2 sits down on a chair, the
+// goal needing both thighs on the seat and supporting.
+TEST(ContactPlanner, SitDownIsPlannedWithBothThighsOnTheSeat) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
+  const PlanningResult r = ContactPlanner(sc).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);
+  int thighs = 0;
+  for (const auto& c : r.plan.stances.back().contacts) {
+    const std::string& name = sc.robot->spots()[c.spec.spot].name;
+    if (name == "r_thigh" || name == "l_thigh") {
+      EXPECT_EQ(sc.scene->surfaces()[c.spec.surface].name, "chair_seat");
+      thighs += c.spec.supporting;
+    }
+  }
+  EXPECT_EQ(thighs, 2);
+}
+
 TEST(ContactPlanner, InvalidStartIsRefused) {
   test::TempDir dir;
   std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
