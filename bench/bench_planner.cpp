@@ -15,6 +15,12 @@ int main(int argc, char** argv) {
   std::string path = ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml";
   double max_seconds = -1;
   for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+      std::printf("Usage: %s [SCENARIO] [--max-seconds T]\n"
+                  "Plans the scenario (default: the chair) with the full planner and with each ablation.\n",
+                  argv[0]);
+      return 0;
+    }
     if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
     else path = argv[i];
   }

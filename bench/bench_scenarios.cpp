@@ -1,0 +1,65 @@
+// Every scenario shipped in models/scenarios planned by the full planner, one
+// after the other in one run: result, wall time, nodes, posture calls and
+// failures, plan length, the non-foot contacts the plan uses, and the
+// independent check's verdict on the plan.
+// Usage: bench_scenarios [SCENARIO...] [--max-seconds T]   (default: every shipped scenario)
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "planner/check/plan_check.h"
+#include "planner/posture/heap_tuning.h"
+#include "planner/search/planner_parameters.h"
+
+using namespace acyclic;
+
+int main(int argc, char** argv) {
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
+  std::vector<std::string> paths;
+  double max_seconds = -1;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+      std::printf("Usage: %s [SCENARIO...] [--max-seconds T]\n"
+                  "Plans each scenario (default: every models/scenarios/*.yaml) with the full planner and prints\n"
+                  "its figures and the independent check's verdict on the plan.\n",
+                  argv[0]);
+      return 0;
+    }
+    if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
+    else paths.push_back(argv[i]);
+  }
+  if (paths.empty()) {
+    for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
+      if (e.path().extension() == ".yaml") paths.push_back(e.path().string());
+    std::sort(paths.begin(), paths.end());
+  }
+  std::printf("%-14s %-16s %9s %7s %7s %7s %8s %-7s %s\n", "scenario", "result", "seconds", "nodes", "calls",
+              "failed", "stances", "check", "non-foot contacts used");
+  for (const auto& path : paths) {
+    const Scenario sc = Scenario::load(path);
+    PlannerParameters p = plannerParameters(sc);
+    if (max_seconds > 0) p.max_seconds = max_seconds;
+    const PlanningResult r = ContactPlanner(sc, p).plan();
+    std::string verdict = "-", used;
+    if (r.solved()) {
+      ValidityChecker checker(sc.robot, sc.scene);
+      verdict = checkPlan(r.plan, sc, checker).valid() ? "valid" : "INVALID";
+      std::set<std::string> names;
+      for (const auto& st : r.plan.stances)
+        for (const auto& c : st.contacts) {
+          const std::string& n = sc.robot->spots()[c.spec.spot].name;
+          if (n != "r_sole" && n != "l_sole") names.insert(n + "@" + sc.scene->surfaces()[c.spec.surface].name);
+        }
+      for (const auto& n : names) used += (used.empty() ? "" : " ") + n;
+    }
+    std::printf("%-14s %-16s %9.2f %7ld %7ld %7ld %8zu %-7s %s\n", sc.name.c_str(), toString(r.status),
+                r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures,
+                r.plan.stances.size(), verdict.c_str(), used.empty() ? "none" : used.c_str());
+    std::fflush(stdout);
+  }
+  return 0;
+}
