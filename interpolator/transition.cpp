@@ -438,10 +438,14 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     if (!path.straightAt(s)) {  // in the air
       t.orientation_tolerance = opt_.air_orientation_tolerance;
       targets.push_back(t);
-      // A body that had to pivot off its surface (held at its other end)
-      // cannot follow every point of a spline either: within straight_slack
-      // of it. (Any other body follows it exactly, or the path is repaired.)
-      if (loose_only) {
+      // Failing that, within straight_slack of it: a body that had to pivot
+      // off its surface (held at its other end) cannot follow every point of
+      // a spline, and neither can a thigh coming down the last millimetres
+      // onto a seat beside the other thigh, both feet planted (that leg's
+      // thigh and foot contacts leave the solver a degenerate problem that
+      // it did not solve in 100 iterations at the exact point; sit_down).
+      // A body that misses its path by more than that is repaired.
+      {
         PoseTarget loose = t;
         loose.touch_margin = kTouchMargin;
         loose.position_tolerance.setConstant(opt_.straight_slack);
