@@ -54,6 +54,7 @@ int main(int argc, char** argv) {
                 sc.robot->numJoints(), sc.robot->numLinks(), sc.robot->spots().size(), sc.robot->totalMass());
     std::printf("  scene %s: %zu obstacles, %zu contact surfaces\n", sc.scene->path().c_str(),
                 sc.scene->obstacles().size(), sc.scene->surfaces().size());
+    std::printf("  goal: %s\n", sc.goal.describe(*sc.robot).c_str());
     acyclic::ValidityChecker checker(sc.robot, sc.scene);
 
     if (!trajectory_path.empty()) {

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "acyclic/cancel_t.hpp"
+#include "acyclic/hrp2_bridge_status_t.hpp"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/process_status_t.hpp"
 #include "acyclic/request_t.hpp"
@@ -129,6 +130,47 @@ TEST(Pipeline, LaunchOnASmallScenarioWritesAValidPlanTrajectoryAndLog) {
   if (haveInterpolator()) {
     EXPECT_EQ(count[channels::kTrajectory], 1);
   }
+}
+
+// The scenario with non-foot contacts that is small enough for the suite:
+// HRP-2 sits down on a chair. The whole pipeline: planned (the goal needs
+// both thighs supporting, which acyclic-check verifies), interpolated, checked
+// sample by sample, and played by the bridge on the simulated controller
+// without a safety event.
+TEST(Pipeline, SitDownIsPlannedInterpolatedAndPlayedWithItsThighContacts) {
+  REQUIRE_NETNS();
+  if (!haveInterpolator()) GTEST_SKIP() << "built without the interpolator";
+  test::TempDir dir;
+  const std::string scenario = test::sourcePath("models/scenarios/sit_down.yaml");
+  const auto run = test::runProcess(exe("acyclic-launch") + " -q --scenario " + scenario + " --out " + dir.path());
+  ASSERT_EQ(run.status, 0) << run.output;
+  const auto check = test::runProcess(exe("acyclic-check") + " " + scenario + " --plan " + dir.path() + "/plan.json");
+  EXPECT_EQ(check.status, 0) << check.output;
+  EXPECT_NE(check.output.find("supported by r_thigh and l_thigh"), std::string::npos) << check.output;
+  const auto tcheck =
+      test::runProcess(exe("acyclic-check") + " " + scenario + " --trajectory " + dir.path() + "/trajectory.json");
+  EXPECT_EQ(tcheck.status, 0) << tcheck.output;
+  // The bridge's last status in the log: every sample streamed, no safety event.
+  lcm::LogFile log(dir.path() + "/run.lcmlog", "r");
+  ASSERT_TRUE(log.good());
+  std::optional<acyclic::hrp2_bridge_status_t> last;
+  acyclic::trajectory_t traj;
+  bool have_traj = false;
+  for (const lcm::LogEvent* e; (e = log.readNextEvent());) {
+    if (e->channel == channels::kHrp2BridgeStatus) {
+      acyclic::hrp2_bridge_status_t st;
+      ASSERT_GE(st.decode(e->data, 0, e->datalen), 0);
+      last = st;
+    } else if (e->channel == channels::kTrajectory) {
+      ASSERT_GE(traj.decode(e->data, 0, e->datalen), 0);
+      have_traj = true;
+    }
+  }
+  ASSERT_TRUE(last.has_value());
+  ASSERT_TRUE(have_traj);
+  EXPECT_GE(last->commands_sent, traj.num_samples);
+  EXPECT_EQ(last->safety_events, 0);
+  EXPECT_LT(last->tracking_error_max, 0.05);
 }
 
 TEST(Pipeline, ReplayOfTheCheckedInLogReproducesItsAnswers) {
