@@ -6,6 +6,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "planner/check/validity.h"
 #include "planner/common/format_error.h"
 #include "planner/guide/guide_author.h"
 #include "planner/search/contact_planner.h"
@@ -41,6 +42,32 @@ void expectGuideFor(const std::string& rel) {
 TEST(GuideAuthor, StepForwardScenario) { expectGuideFor("models/scenarios/step_forward.yaml"); }
 
 TEST(GuideAuthor, ChairScenario) { expectGuideFor("models/scenarios/chair_table.yaml"); }
+
+// On the wet ramp no posture stands on the feet alone: the guide ends on the
+// start stance carried up the ramp (feet on the ramp, palms on the bars), a
+// posture the independent check accepts with those contacts, in the goal.
+TEST(GuideAuthor, WetRampEndsOnTheStartStanceCarriedIntoTheGoal) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/wet_ramp.yaml"));
+  const GuideResult r = authorGuide(sc, GuideOptions());
+  ASSERT_TRUE(r.success()) << r.reason;
+  const auto& keys = r.guide.key_postures;
+  ASSERT_GE(keys.size(), 2u);
+  EXPECT_EQ(keys.front().joints, sc.start.joints);
+  EXPECT_EQ(keys.front().base_position, sc.start.base_position);
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(keys.back());
+  std::vector<ContactSpec> carried = sc.start_stance;
+  for (auto& c : carried) {
+    const Surface& surf = sc.scene->surfaces()[c.surface];
+    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
+    const Eigen::Vector3d in_surface = surf.frame.inverse() * kin.spotPose(c.spot).translation();
+    EXPECT_LT(std::abs(in_surface.z()), 1e-3) << sc.describe(c);  // on its surface
+  }
+  EXPECT_TRUE(sc.goal.satisfied(kin, carried));
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checker.checkPosture(keys.back(), carried).valid());
+  EXPECT_NO_THROW(GuidePotential(keys, 1.0, 0.05));
+}
 
 TEST(GuideAuthor, SameScenarioAndSeedSameGuide) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));

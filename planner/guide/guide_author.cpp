@@ -103,10 +103,37 @@ class SeededSimplifier : public og::PathSimplifier {
   }
 };
 
-// A standing posture in the goal region: the named standing posture moved
-// there, feet put on the start's floor surface, then the posture generator
-// and the independent check. Tries the free horizontal coordinate around the
-// start's, nearest first.
+// A goal posture: a witness of `contacts` (placed where `q` puts their spots)
+// from the guess q, accepted by the independent check, in the goal (the
+// link's bound, and the supports the goal names).
+bool solveGoalStance(const Scenario& sc, PostureGenerator& pg, ValidityChecker& checker, Kinematics& kin,
+                     const Configuration& q, std::vector<ContactSpec> contacts, Configuration& out) {
+  kin.setConfiguration(q);
+  for (auto& c : contacts) {
+    const Surface& surf = sc.scene->surfaces()[c.surface];
+    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
+    c.supporting = true;
+    if (!surf.polygon.contains(Eigen::Vector2d(c.placement.x, c.placement.y))) return false;  // carried off it
+  }
+  PostureRequest r;
+  r.contacts = contacts;
+  r.initial_guess = q;
+  const PostureResult res = pg.solve(r);
+  if (!res.success()) return false;
+  if (!checker.checkPosture(res.configuration, contacts).valid()) return false;
+  kin.setConfiguration(res.configuration);
+  if (!sc.goal.satisfied(kin, contacts)) return false;
+  out = res.configuration;
+  return true;
+}
+
+// A posture in the goal region. First standing: the named standing posture
+// moved there, feet put on the start's floor surface. Failing that (a robot
+// that cannot stand on its feet alone there, as on the wet ramp), the start
+// stance carried there: the start posture moved along the goal's axis, each
+// start contact put on its surface where the moved posture holds its spot.
+// Each through the posture generator and the independent check, the free
+// horizontal coordinate tried around the start's, nearest first.
 bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, std::string& why) {
   const RobotModel& m = *sc.robot;
   if (!m.postures().count(o.standing_posture)) {
@@ -130,9 +157,6 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
   const double yaw = yawOf(sc.start.base_orientation);
   standing.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
   Kinematics kin(sc.robot);
-  // Where the goal link sits relative to the base when standing.
-  kin.setConfiguration(standing);
-  const Eigen::Vector3d link_offset = kin.linkPose(g.link).translation() - standing.base_position;
   const double bound = std::isfinite(g.min) ? g.min + o.goal_margin : g.max - o.goal_margin;
   PostureGeneratorOptions po;
   po.max_iterations = 200;
@@ -142,31 +166,28 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
   const int free_axis = g.axis == 0 ? 1 : 0;
   std::vector<double> offsets = {0.0};
   for (double d = 0.1; d <= o.goal_search + 1e-9; d += 0.1) offsets.push_back(d), offsets.push_back(-d);
+  // Where the goal link sits relative to the base, standing and at the start.
+  kin.setConfiguration(standing);
+  const Eigen::Vector3d standing_offset = kin.linkPose(g.link).translation() - standing.base_position;
+  kin.setConfiguration(sc.start);
+  const Eigen::Vector3d start_offset = kin.linkPose(g.link).translation() - sc.start.base_position;
+  std::vector<ContactSpec> feet(2);
+  feet[0].spot = r_sole, feet[1].spot = l_sole;
+  feet[0].surface = feet[1].surface = floor;
   for (double off : offsets) {
     Configuration q = standing;
-    q.base_position[g.axis] = bound - link_offset[g.axis];
+    q.base_position[g.axis] = bound - standing_offset[g.axis];
     q.base_position[free_axis] = sc.start.base_position[free_axis] + off;
-    kin.setConfiguration(q);
-    PostureRequest r;
-    for (int spot : {r_sole, l_sole}) {
-      ContactSpec c;
-      c.spot = spot;
-      c.surface = floor;
-      c.supporting = true;
-      c.placement = projectOnSurface(sc.scene->surfaces()[floor], kin.spotPose(spot));
-      r.contacts.push_back(c);
-    }
-    r.initial_guess = q;
-    const PostureResult res = pg.solve(r);
-    if (!res.success()) continue;
-    if (!checker.checkPosture(res.configuration, r.contacts).valid()) continue;
-    kin.setConfiguration(res.configuration);
-    if (!g.linkWithinBounds(kin)) continue;
-    out = res.configuration;
-    return true;
+    if (solveGoalStance(sc, pg, checker, kin, q, feet, out)) return true;
   }
-  why = "no valid standing posture found in the goal region (" + g.describe(m) + ") within " +
-        std::to_string(o.goal_search) + " m of the start";
+  for (double off : offsets) {
+    Configuration q = sc.start;
+    q.base_position[g.axis] = bound - start_offset[g.axis];
+    q.base_position[free_axis] += off;
+    if (solveGoalStance(sc, pg, checker, kin, q, sc.start_stance, out)) return true;
+  }
+  why = "no valid standing posture, nor the start stance carried there, found in the goal region (" +
+        g.describe(m) + ") within " + std::to_string(o.goal_search) + " m of the start";
   return false;
 }
 
