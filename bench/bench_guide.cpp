@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -20,13 +21,22 @@ int main(int argc, char** argv) {
   int seeds = 5;
   double max_seconds = -1;
   for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+      std::printf("Usage: %s [SCENARIO...] [--seeds N] [--max-seconds T]\n"
+                  "The OMPL guide's time on each scenario (default: every models/scenarios/*.yaml), median over\n"
+                  "seeds 1..N, then each planned with its hand-written guide and with the OMPL guide.\n",
+                  argv[0]);
+      return 0;
+    }
     if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
     else paths.push_back(argv[i]);
   }
-  if (paths.empty())
-    paths = {ACYCLIC_SOURCE_DIR "/models/scenarios/step_forward.yaml",
-             ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml"};
+  if (paths.empty()) {  // every shipped scenario
+    for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
+      if (e.path().extension() == ".yaml") paths.push_back(e.path().string());
+    std::sort(paths.begin(), paths.end());
+  }
   std::printf("%-14s %-18s %12s %12s %8s\n", "scenario", "guide", "median s", "max s", "keys");
   std::vector<Guide> guides;
   for (const auto& path : paths) {
