@@ -17,16 +17,21 @@ using namespace acyclic;
 
 namespace {
 
+// The guide of sc, which must exist and start at the start posture, exactly.
+void expectGuideFromTheStart(const Scenario& sc, GuideResult& r) {
+  r = authorGuide(sc, GuideOptions());
+  ASSERT_TRUE(r.success()) << sc.name << ": " << r.reason;
+  ASSERT_GE(r.guide.key_postures.size(), 2u);
+  EXPECT_EQ(r.guide.key_postures.front().joints, sc.start.joints);
+  EXPECT_EQ(r.guide.key_postures.front().base_position, sc.start.base_position);
+}
+
 void expectGuideFor(const std::string& rel) {
   const Scenario sc = Scenario::load(test::sourcePath(rel));
-  GuideOptions o;
-  const GuideResult r = authorGuide(sc, o);
-  ASSERT_TRUE(r.success()) << rel << ": " << r.reason;
+  GuideResult r;
+  expectGuideFromTheStart(sc, r);
+  if (::testing::Test::HasFatalFailure()) return;
   const auto& keys = r.guide.key_postures;
-  ASSERT_GE(keys.size(), 2u);
-  // Starts at the start posture, exactly.
-  EXPECT_EQ(keys.front().joints, sc.start.joints);
-  EXPECT_EQ(keys.front().base_position, sc.start.base_position);
   // Ends standing in the goal region.
   Kinematics kin(sc.robot);
   kin.setConfiguration(keys.back());
@@ -48,12 +53,9 @@ TEST(GuideAuthor, ChairScenario) { expectGuideFor("models/scenarios/chair_table.
 // posture the independent check accepts with those contacts, in the goal.
 TEST(GuideAuthor, WetRampEndsOnTheStartStanceCarriedIntoTheGoal) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/wet_ramp.yaml"));
-  const GuideResult r = authorGuide(sc, GuideOptions());
-  ASSERT_TRUE(r.success()) << r.reason;
+  GuideResult r;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, r));
   const auto& keys = r.guide.key_postures;
-  ASSERT_GE(keys.size(), 2u);
-  EXPECT_EQ(keys.front().joints, sc.start.joints);
-  EXPECT_EQ(keys.front().base_position, sc.start.base_position);
   Kinematics kin(sc.robot);
   kin.setConfiguration(keys.back());
   std::vector<ContactSpec> carried = sc.start_stance;
