@@ -6,8 +6,7 @@ namespace acyclic::hrp2 {
 
 CheckResult checkContract(const Trajectory& tr, const Scenario& sc, const std::function<void(int, int)>& progress) {
   ValidityChecker checker(sc.robot, sc.scene);
-  checker.setClearanceCutoff(0.02);  // verdicts only, sample after sample (planner/check/validity.h)
-  checker.setWarmStart(true);
+  checker.checkVerdictsInSequence();  // verdicts only, sample after sample (planner/check/validity.h)
   TrajectoryCheckOptions opt;
   opt.max_violations = 1;
   const TrajectoryReport rep = acyclic::checkTrajectory(tr, sc, checker, opt, progress);

@@ -150,8 +150,7 @@ TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options
   // Thousands of checks in sequence, for their verdict only: pairs that
   // cannot be within 2 cm are not measured, and the equilibrium LPs start
   // from the previous check's basis (validity.h).
-  checker_.setClearanceCutoff(0.02);
-  checker_.setWarmStart(true);
+  checker_.checkVerdictsInSequence();
 }
 
 namespace {
@@ -445,12 +444,10 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
       // thigh and foot contacts leave the solver a degenerate problem that
       // it did not solve in 100 iterations at the exact point; sit_down).
       // A body that misses its path by more than that is repaired.
-      {
-        PoseTarget loose = t;
-        loose.touch_margin = kTouchMargin;
-        loose.position_tolerance.setConstant(opt_.straight_slack);
-        targets.push_back(loose);
-      }
+      PoseTarget loose = t;
+      loose.touch_margin = kTouchMargin;
+      loose.position_tolerance.setConstant(opt_.straight_slack);
+      targets.push_back(loose);
     } else {
       // Near the surface: first exactly on the path (straight along the
       // normal, orientation held: a sole or a palm leaves flat).

@@ -61,8 +61,7 @@ int main(int argc, char** argv) {
       const acyclic::Trajectory tr = acyclic::readTrajectory(trajectory_path, sc);
       // Samples are checked for their verdicts, in sequence: the same
       // verdicts, faster (planner/check/validity.h).
-      checker.setClearanceCutoff(0.02);
-      checker.setWarmStart(true);
+      checker.checkVerdictsInSequence();
       std::printf("trajectory %s: %zu samples, %zu phases, %.3f s\n", trajectory_path.c_str(), tr.samples.size(),
                   tr.phases.size(), tr.duration());
       const bool tty = isatty(STDERR_FILENO);

@@ -60,6 +60,12 @@ class ValidityChecker {
   // The equilibrium LPs warm-started (QuasiStaticChecker::setWarmStart): same
   // verdicts, faster along a trajectory.
   void setWarmStart(bool on) { statics_.setWarmStart(on); }
+  // Both, as every caller that checks the samples of a trajectory one after
+  // the other for their verdicts uses them: a 2 cm cutoff, warm LPs.
+  void checkVerdictsInSequence() {
+    setClearanceCutoff(0.02);
+    setWarmStart(true);
+  }
 
  private:
   std::shared_ptr<const RobotModel> robot_;
