@@ -90,6 +90,7 @@ struct ContactPlanner::Impl {
     Change change = Change::Root;
     int generator = -1;                   // the pair generator that made it (lazy sons)
     int depth = 0;                        // contact changes from the start (set by addNode)
+    int changed_spot = -1;                // the spot of the contact added or removed from its parent
     bool dead = false;                    // no plan can be exported through it (exportPlan): not expanded
     std::vector<FailedPair> failed_pairs;  // first candidate failed here, or remembered from the parent
   };
@@ -118,8 +119,22 @@ struct ContactPlanner::Impl {
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
 
+  // Per spot, the joint its limb hangs from: the last joint on the way from
+  // the spot's link to the base whose parent link branches (a leg's hip yaw,
+  // an arm's shoulder).
+  std::vector<int> limb;
+
   Impl(const Scenario& s, PlannerParameters params)
       : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), rng(s.seed) {
+    const RobotModel& m = *s.robot;
+    std::vector<int> children(m.numLinks(), 0);
+    for (const auto& j : m.joints()) ++children[j.parent_link];
+    for (const auto& spot : m.spots()) {
+      int root = -1;
+      for (int j : m.ancestorJoints(spot.link))  // base to link
+        if (children[m.joints()[j].parent_link] > 1) root = j;
+      limb.push_back(root);
+    }
     for (int t = 0; t < std::max(1, p.threads); ++t)
       pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
     if (p.guide_potential) {
@@ -327,6 +342,7 @@ struct ContactPlanner::Impl {
       son.q = results[k].configuration;
       son.parent = ni;
       son.change = Change::Removed;
+      son.changed_spot = nodes[ni].contacts[c].spot;
       addNode(son);
     }
   }
@@ -412,6 +428,7 @@ struct ContactPlanner::Impl {
     son.q = res.configuration;
     son.parent = g.node;
     son.change = Change::Added;
+    son.changed_spot = g.spot;
     son.generator = gi;
     son.key = key;  // also orders the parts of its volume
     if (p.optimized_candidates)
@@ -436,11 +453,15 @@ struct ContactPlanner::Impl {
   // from where it failed, not from the parent: a robot shuffling its feet a
   // few centimetres at a time toward a chair would otherwise carry a thigh's
   // failure all the way to the seat, and never try it there (sit_down from
-  // 0.3 m away: not found in 3,000 nodes; without the memory, 64).
+  // 0.3 m away: not found in 3,000 nodes; without the memory, 64). Not past
+  // a change on the spot's own limb: a thigh that could not lie flat on the
+  // seat with its foot where it was may once that foot is moved (the leg's
+  // chain from hip to foot is what failed), and was never retried there.
   bool rememberedFailure(int ni, int spot, int surface) {
     if (!p.failure_memory || !p.optimized_candidates) return false;
     const int pi = nodes[ni].parent;
     if (pi < 0) return false;
+    if (nodes[ni].changed_spot >= 0 && limb[nodes[ni].changed_spot] == limb[spot]) return false;
     const auto& failed = nodes[pi].failed_pairs;
     auto it = std::find_if(failed.begin(), failed.end(),
                            [&](const FailedPair& f) { return f.spot == spot && f.surface == surface; });

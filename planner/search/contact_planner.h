@@ -50,6 +50,8 @@ struct PlannerParameters {
   // and failure_memory_angle of where it was: the same local problem from the
   // same place fails again. Pairs that cannot be made from a posture (a knee
   // on the table from a seat) otherwise cost a failed call at every node.
+  // A son that adds or removes a contact on the spot's own limb (the foot of
+  // the leg whose thigh failed) poses a new problem: the memory stops there.
   bool failure_memory = true;
   double failure_memory_distance = 0.05;  // m
   double failure_memory_angle = 0.35;     // rad
