@@ -1,5 +1,6 @@
 #include "planner/guide/guide_author.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -127,6 +128,111 @@ bool solveGoalStance(const Scenario& sc, PostureGenerator& pg, ValidityChecker& 
   return true;
 }
 
+// The goal's supports added to a stance one at a time, as the planner adds
+// a contact: each floating over `surface` and touching only, from the last
+// witness; then the whole stance with every contact supporting, checked and
+// in the goal.
+bool addSupports(const Scenario& sc, PostureGenerator& pg, ValidityChecker& checker, Kinematics& kin,
+                 std::vector<ContactSpec> stance, int surface, Configuration q, Configuration& out) {
+  const Surface& surf = sc.scene->surfaces()[surface];
+  for (int s : sc.goal.supporting_spots) {
+    PostureRequest r;
+    r.contacts = stance;
+    r.initial_guess = q;
+    FloatingContact f;
+    f.spot = s;
+    f.surface = surface;
+    f.volume.polygon = surf.polygon;
+    r.floating = f;
+    const PostureResult res = pg.solve(r);
+    if (!res.success()) return false;
+    q = res.configuration;
+    kin.setConfiguration(q);
+    ContactSpec c;
+    c.spot = s;
+    c.surface = surface;
+    c.supporting = false;
+    c.placement = projectOnSurface(surf, kin.spotPose(s));  // the spot's own in-plane angle (not modulo pi)
+    stance.push_back(c);
+  }
+  return solveGoalStance(sc, pg, checker, kin, q, stance, out);
+}
+
+// A posture resting on the goal's supports, for a goal on the link's height
+// (sitting down, kneeling), as the planner gets there: the start stance
+// carried toward a surface the supports may rest on, then the supports added
+// (addSupports: touching first, the start's contacts holding the robot, which
+// must lower itself onto them). Carried by distances around the surface's
+// nearest point (where a sitting robot's feet go: in front of the seat),
+// nearest that point first, at most `support_attempts` in all. Every
+// support on one surface (both thighs on a seat, both knees on the floor).
+bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGenerator& pg, ValidityChecker& checker,
+                           Kinematics& kin, Configuration& out) {
+  const GoalCondition& g = sc.goal;
+  if (g.supporting_spots.empty()) return false;
+  kin.setConfiguration(sc.start);
+  const double link_z = kin.linkPose(g.link).translation().z();
+  const double target = std::isfinite(g.max) ? g.max - o.goal_margin : g.min + o.goal_margin;
+  const Eigen::Vector2d from = sc.start.base_position.head<2>();
+  struct Candidate {
+    double order;
+    Eigen::Vector2d shift;
+    int surface;
+  };
+  std::vector<Candidate> candidates;
+  for (int si : sc.allowed_surfaces) {
+    const Surface& surf = sc.scene->surfaces()[si];
+    // The surface's point nearest the start's base, in the surface's plane
+    // (the base itself when it is over the surface).
+    const Eigen::Vector2d local = (surf.frame.inverse() * sc.start.base_position).head<2>();
+    Eigen::Vector2d nearest_local = local;
+    if (!surf.polygon.contains(local)) {
+      double closest = std::numeric_limits<double>::infinity();
+      const auto& v = surf.polygon.vertices();
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        const Eigen::Vector2d a = v[k], e = v[(k + 1) % v.size()] - a;
+        const Eigen::Vector2d p = a + std::clamp((local - a).dot(e) / e.squaredNorm(), 0.0, 1.0) * e;
+        if ((p - local).norm() < closest) closest = (p - local).norm(), nearest_local = p;
+      }
+    }
+    const Eigen::Vector2d nearest = (surf.frame * Eigen::Vector3d(nearest_local.x(), nearest_local.y(), 0)).head<2>();
+    const double best = (nearest - from).norm();  // horizontal
+    const Eigen::Vector2d dir = best > 1e-9 ? Eigen::Vector2d((nearest - from) / best) : Eigen::Vector2d::Zero();
+    for (double d = std::max(0.0, best - 0.15); d <= best + 0.15 + 1e-9; d += 0.05) {
+      candidates.push_back({std::abs(d - best), d * dir, si});
+      if (best <= 1e-9) break;  // on it: no direction to carry
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.order < b.order; });
+  for (std::size_t i = 0; i < candidates.size() && static_cast<int>(i) < o.support_attempts; ++i) {
+    Configuration q = sc.start;
+    q.base_position.head<2>() += candidates[i].shift;
+    kin.setConfiguration(q);
+    std::vector<ContactSpec> stance = sc.start_stance;
+    bool on = true;
+    for (auto& c : stance) {
+      const Surface& surf = sc.scene->surfaces()[c.surface];
+      c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
+      c.supporting = true;
+      on = on && surf.polygon.contains(Eigen::Vector2d(c.placement.x, c.placement.y));
+    }
+    if (!on) continue;
+    // Lowered on the start's contacts: its goal link pulled to the bound, the
+    // joints free to fold (a squat over the feet before the seat is touched).
+    Configuration lowered = q;
+    lowered.base_position.z() += target - link_z;
+    PostureRequest r;
+    r.contacts = stance;
+    r.initial_guess = q;
+    r.cost = std::make_shared<ReferencePostureCost>(lowered, 0.01, 10.0, 1.0);
+    const PostureResult res = pg.solve(r);
+    if (!res.success()) continue;
+    if (addSupports(sc, pg, checker, kin, stance, candidates[i].surface, res.configuration, out)) return true;
+  }
+  return false;
+}
+
 // A posture in the goal region. First standing: the named standing posture
 // moved there, feet put on the start's floor surface. Failing that (a robot
 // that cannot stand on its feet alone there, as on the wet ramp), the start
@@ -149,20 +255,24 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
     return false;
   }
   const GoalCondition& g = sc.goal;
-  if (g.axis == 2) {
-    why = "a goal on the vertical axis is not supported by the guide author";
-    return false;
-  }
-  Configuration standing = m.posture(o.standing_posture);
   const double yaw = yawOf(sc.start.base_orientation);
-  standing.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
   Kinematics kin(sc.robot);
-  const double bound = std::isfinite(g.min) ? g.min + o.goal_margin : g.max - o.goal_margin;
   PostureGeneratorOptions po;
   po.max_iterations = 200;
   po.max_seconds = 2.0;
   PostureGenerator pg(sc.robot, sc.scene, po);
   ValidityChecker checker(sc.robot, sc.scene);
+  if (g.axis == 2) {  // a height: nothing to carry along; only a posture on the goal's supports
+    if (goalPostureOnSupports(sc, o, pg, checker, kin, out)) return true;
+    why = g.supporting_spots.empty()
+              ? "a goal on the vertical axis needs supported_by: the guide author rests the robot on those spots"
+              : "no valid posture resting on the goal's supports found in the goal region (" + g.describe(m) +
+                    ") in " + std::to_string(o.support_attempts) + " placements";
+    return false;
+  }
+  Configuration standing = m.posture(o.standing_posture);
+  standing.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  const double bound = std::isfinite(g.min) ? g.min + o.goal_margin : g.max - o.goal_margin;
   const int free_axis = g.axis == 0 ? 1 : 0;
   std::vector<double> offsets = {0.0};
   for (double d = 0.1; d <= o.goal_search + 1e-9; d += 0.1) offsets.push_back(d), offsets.push_back(-d);

@@ -1,7 +1,9 @@
 #pragma once
 // The rough-trajectory author (issue 7): the paper's guide was written by
 // hand; here OMPL writes it. From the scenario's start configuration to a
-// standing posture in the goal region (made by the posture generator), it
+// posture in the goal region made by the posture generator (standing there;
+// or the start stance carried there; for a goal on the height of a link, the
+// robot resting on the goal's supported_by spots, as when it sits down), it
 // plans in a reduced space - the base's position and heading, and a blend
 // parameter alpha that carries every other coordinate from the start
 // posture to the goal posture - with FCL checking the scene against robot
@@ -23,6 +25,7 @@ struct GuideOptions {
   int shortcut_steps = 300;     // PathSimplifier attempts (counts, not time: deterministic)
   double goal_margin = 0.05;    // m: how far past the goal's bound the goal posture stands
   double goal_search = 0.6;     // m: the goal posture's free coordinate tried within +- this of the start's
+  int support_attempts = 40;    // start stances carried toward a surface, for a goal posture on supported_by spots
   std::string standing_posture = "half_sitting";  // the robot's named posture the goal posture starts from
   unsigned seed = 1;
 };
