@@ -160,9 +160,9 @@ bool addSupports(const Scenario& sc, PostureGenerator& pg, ValidityChecker& chec
 
 // A posture resting on the goal's supports, for a goal on the link's height
 // (sitting down, kneeling), as the planner gets there: the start stance
-// carried toward a surface the supports may rest on, then the supports added
-// (addSupports: touching first, the start's contacts holding the robot, which
-// must lower itself onto them). Carried by distances around the surface's
+// carried toward a surface the supports may rest on, lowered on its own
+// contacts (a squat), then the supports added (addSupports: touching first,
+// the start's contacts holding the robot). Carried by distances around the surface's
 // nearest point (where a sitting robot's feet go: in front of the seat),
 // nearest that point first, at most `support_attempts` in all. Every
 // support on one surface (both thighs on a seat, both knees on the floor).
