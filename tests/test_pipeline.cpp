@@ -133,15 +133,18 @@ TEST(Pipeline, LaunchOnASmallScenarioWritesAValidPlanTrajectoryAndLog) {
 }
 
 // The scenario with non-foot contacts that is small enough for the suite:
-// HRP-2 sits down on a chair. The whole pipeline: planned (the goal needs
-// both thighs supporting, which acyclic-check verifies), interpolated, checked
-// sample by sample, and played by the bridge on the simulated controller
-// without a safety event.
-TEST(Pipeline, SitDownIsPlannedInterpolatedAndPlayedWithItsThighContacts) {
+// HRP-2 sits down on a chair, its key postures left out so that the guide
+// process authors them (OMPL). The whole pipeline: guided, planned (the goal
+// needs both thighs supporting, which acyclic-check verifies), interpolated,
+// checked sample by sample, and played by the bridge on the simulated
+// controller without a safety event.
+TEST(Pipeline, SitDownIsGuidedPlannedInterpolatedAndPlayedWithItsThighContacts) {
   REQUIRE_NETNS();
   if (!haveInterpolator()) GTEST_SKIP() << "built without the interpolator";
   test::TempDir dir;
-  const std::string scenario = test::sourcePath("models/scenarios/sit_down.yaml");
+  std::string text = test::scenarioText("models/scenarios/sit_down.yaml");
+  text = text.substr(0, text.find("key_postures:"));
+  const std::string scenario = dir.write("sit_down_no_keys.yaml", text);
   const auto run = test::runProcess(exe("acyclic-launch") + " -q --scenario " + scenario + " --out " + dir.path());
   ASSERT_EQ(run.status, 0) << run.output;
   const auto check = test::runProcess(exe("acyclic-check") + " " + scenario + " --plan " + dir.path() + "/plan.json");
@@ -156,7 +159,9 @@ TEST(Pipeline, SitDownIsPlannedInterpolatedAndPlayedWithItsThighContacts) {
   std::optional<acyclic::hrp2_bridge_status_t> last;
   acyclic::trajectory_t traj;
   bool have_traj = false;
+  int guides = 0;
   for (const lcm::LogEvent* e; (e = log.readNextEvent());) {
+    guides += e->channel == channels::kGuide;
     if (e->channel == channels::kHrp2BridgeStatus) {
       acyclic::hrp2_bridge_status_t st;
       ASSERT_GE(st.decode(e->data, 0, e->datalen), 0);
@@ -166,6 +171,7 @@ TEST(Pipeline, SitDownIsPlannedInterpolatedAndPlayedWithItsThighContacts) {
       have_traj = true;
     }
   }
+  EXPECT_EQ(guides, 1);
   ASSERT_TRUE(last.has_value());
   ASSERT_TRUE(have_traj);
   EXPECT_GE(last->commands_sent, traj.num_samples);
