@@ -40,7 +40,7 @@ void expectGuideFor(const std::string& rel) {
   EXPECT_NEAR(keys.back().base_position.z(), sc.robot->posture("half_sitting").base_position.z(), 0.05);
   // A usable guide: the guide potential accepts it (one-to-one base path).
   EXPECT_NO_THROW(GuidePotential(keys, 1.0, 0.05));
-  EXPECT_LT(r.guide.seconds, 10.0);
+  // Its time is bench_guide's to measure, not a test's.
 }
 
 }  // namespace
