@@ -1,6 +1,7 @@
 // The OMPL guide author: its time on each scenario (median over seeds), then
 // each scenario planned with the hand-written key postures and with the OMPL
-// guide only, side by side in one run: wall time, nodes, plan length.
+// guide only, side by side in one run: wall time, nodes, plan length, and the
+// independent check's verdict on each plan (planner/check/plan_check.h).
 // Usage: bench_guide [SCENARIO...] [--seeds N] [--max-seconds T]
 #include <algorithm>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "planner/check/plan_check.h"
 #include "planner/guide/guide_author.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/search/planner_parameters.h"
@@ -24,7 +26,8 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
       std::printf("Usage: %s [SCENARIO...] [--seeds N] [--max-seconds T]\n"
                   "The OMPL guide's time on each scenario (default: every models/scenarios/*.yaml), median over\n"
-                  "seeds 1..N, then each planned with its hand-written guide and with the OMPL guide.\n",
+                  "seeds 1..N, then each planned with its hand-written guide and with the OMPL guide, each plan\n"
+                  "checked by the independent check (valid / INVALID).\n",
                   argv[0]);
       return 0;
     }
@@ -56,8 +59,8 @@ int main(int argc, char** argv) {
                 t.back(), first.guide.key_postures.size());
     guides.push_back(first.guide);
   }
-  std::printf("\n%-14s %-12s %-22s %9s %7s %9s %8s\n", "scenario", "guide", "result", "seconds", "nodes", "calls",
-              "stances");
+  std::printf("\n%-14s %-12s %-22s %9s %7s %9s %8s %s\n", "scenario", "guide", "result", "seconds", "nodes", "calls",
+              "stances", "check");
   for (std::size_t i = 0; i < paths.size(); ++i) {
     const Scenario base = Scenario::load(paths[i]);
     for (const bool ompl : {false, true}) {
@@ -70,9 +73,14 @@ int main(int argc, char** argv) {
       PlannerParameters p = plannerParameters(sc);
       if (max_seconds > 0) p.max_seconds = max_seconds;
       const PlanningResult r = ContactPlanner(sc, p).plan();
-      std::printf("%-14s %-12s %-22s %9.2f %7ld %9ld %8zu\n", sc.name.c_str(), ompl ? "OMPL" : "hand",
+      std::string verdict = "-";
+      if (r.solved()) {
+        ValidityChecker checker(sc.robot, sc.scene);
+        verdict = checkPlan(r.plan, sc, checker).valid() ? "valid" : "INVALID";
+      }
+      std::printf("%-14s %-12s %-22s %9.2f %7ld %9ld %8zu %s\n", sc.name.c_str(), ompl ? "OMPL" : "hand",
                   toString(r.status), r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls,
-                  r.plan.stances.size());
+                  r.plan.stances.size(), verdict.c_str());
       std::fflush(stdout);
     }
   }
