@@ -131,6 +131,26 @@ TEST(GuideAuthor, SitDownIsPlannedWithTheGuidesSeatedPostureLeaningLessOrMore) {
   }
 }
 
+// A height goal on supports the start already has (a crouch on the feet):
+// the start stance lowered there, nothing to add.
+TEST(GuideAuthor, ACrouchOnTheFeetEndsLoweredOnTheStartStance) {
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  const auto at = text.find("goal:");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, text.find('\n', at) - at, "goal: {link: WAIST, axis: z, max: 0.55, supported_by: [r_sole, l_sole]}");
+  test::TempDir dir;
+  const Scenario sc = Scenario::load(dir.write("crouch.yaml", text));
+  GuideResult r;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, r));
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(r.guide.key_postures.back());
+  std::vector<ContactSpec> feet = sc.start_stance;
+  for (auto& c : feet) c.placement = projectOnSurface(sc.scene->surfaces()[c.surface], kin.spotPose(c.spot));
+  EXPECT_TRUE(sc.goal.satisfied(kin, feet));
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checker.checkPosture(r.guide.key_postures.back(), feet).valid());
+}
+
 TEST(GuideAuthor, AHeightGoalWithoutSupportsIsRefusedWithTheReason) {
   std::string text = test::scenarioText("models/scenarios/sit_down.yaml");
   const std::string supports = ", supported_by: [r_thigh, l_thigh]";

@@ -136,6 +136,9 @@ bool addSupports(const Scenario& sc, PostureGenerator& pg, ValidityChecker& chec
                  std::vector<ContactSpec> stance, int surface, Configuration q, Configuration& out) {
   const Surface& surf = sc.scene->surfaces()[surface];
   for (int s : sc.goal.supporting_spots) {
+    bool held = false;  // a start contact already (a crouch on the feet)
+    for (const auto& c : stance) held = held || c.spot == s;
+    if (held) continue;
     PostureRequest r;
     r.contacts = stance;
     r.initial_guess = q;
