@@ -38,6 +38,9 @@ TEST(Geometry, PolygonSignedDistanceAndOrientation) {
   EXPECT_TRUE(sq.contains({1.0005, 0.5}, 1e-3));
   EXPECT_FALSE(sq.contains({1.0005, 0.5}));
   EXPECT_LT((sq.centroid() - Eigen::Vector2d(0.5, 0.5)).norm(), 1e-12);
+  EXPECT_LT((sq.nearestBoundaryPoint({2, 0.5}) - Eigen::Vector2d(1, 0.5)).norm(), 1e-12);
+  EXPECT_LT((sq.nearestBoundaryPoint({2, 2}) - Eigen::Vector2d(1, 1)).norm(), 1e-12);  // a corner
+  EXPECT_LT((sq.nearestBoundaryPoint({0.5, 0.9}) - Eigen::Vector2d(0.5, 1)).norm(), 1e-12);  // from inside
 }
 
 TEST(Geometry, PolygonRejectsBadInput) {

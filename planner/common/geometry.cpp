@@ -52,19 +52,28 @@ ConvexPolygon::ConvexPolygon(std::vector<Eigen::Vector2d> v) : v_(std::move(v)) 
   }
 }
 
+Eigen::Vector2d ConvexPolygon::nearestBoundaryPoint(const Eigen::Vector2d& p) const {
+  const std::size_t n = v_.size();
+  Eigen::Vector2d best = v_[0];
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d a = v_[i], e = v_[(i + 1) % n] - a;
+    const Eigen::Vector2d q = a + std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0) * e;
+    if ((q - p).norm() < best_distance) best_distance = (q - p).norm(), best = q;
+  }
+  return best;
+}
+
 double ConvexPolygon::signedDistance(const Eigen::Vector2d& p) const {
   const std::size_t n = v_.size();
   double max_out = -std::numeric_limits<double>::infinity();  // max signed edge distance
-  double min_edge = std::numeric_limits<double>::infinity();  // exact distance to the boundary
   for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d a = v_[i], b = v_[(i + 1) % n];
-    const Eigen::Vector2d e = b - a;
+    const Eigen::Vector2d a = v_[i], e = v_[(i + 1) % n] - a;
     const Eigen::Vector2d outward(e.y(), -e.x());
     max_out = std::max(max_out, outward.normalized().dot(p - a));
-    double t = std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
-    min_edge = std::min(min_edge, (a + t * e - p).norm());
   }
-  return max_out > 0 ? min_edge : -min_edge;
+  const double to_boundary = (nearestBoundaryPoint(p) - p).norm();  // exact
+  return max_out > 0 ? to_boundary : -to_boundary;
 }
 
 double ConvexPolygon::area() const {

@@ -28,6 +28,8 @@ class ConvexPolygon {
   // Signed distance from p to the boundary: negative inside, positive outside
   // (exact outside, minus the distance to the nearest edge inside).
   double signedDistance(const Eigen::Vector2d& p) const;
+  // The point of the boundary nearest p (inside or out).
+  Eigen::Vector2d nearestBoundaryPoint(const Eigen::Vector2d& p) const;
   bool contains(const Eigen::Vector2d& p, double tolerance = 0.0) const {
     return signedDistance(p) <= tolerance;
   }
