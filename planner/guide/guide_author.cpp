@@ -104,18 +104,26 @@ class SeededSimplifier : public og::PathSimplifier {
   }
 };
 
+// Each contact placed where kin holds its spot, supporting; false if one
+// lies off its surface's polygon (carried off it).
+bool placeWhereHeld(const Scenario& sc, const Kinematics& kin, std::vector<ContactSpec>& contacts) {
+  bool on = true;
+  for (auto& c : contacts) {
+    const Surface& surf = sc.scene->surfaces()[c.surface];
+    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
+    c.supporting = true;
+    on = on && surf.polygon.contains(Eigen::Vector2d(c.placement.x, c.placement.y));
+  }
+  return on;
+}
+
 // A goal posture: a witness of `contacts` (placed where `q` puts their spots)
 // from the guess q, accepted by the independent check, in the goal (the
 // link's bound, and the supports the goal names).
 bool solveGoalStance(const Scenario& sc, PostureGenerator& pg, ValidityChecker& checker, Kinematics& kin,
                      const Configuration& q, std::vector<ContactSpec> contacts, Configuration& out) {
   kin.setConfiguration(q);
-  for (auto& c : contacts) {
-    const Surface& surf = sc.scene->surfaces()[c.surface];
-    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
-    c.supporting = true;
-    if (!surf.polygon.contains(Eigen::Vector2d(c.placement.x, c.placement.y))) return false;  // carried off it
-  }
+  if (!placeWhereHeld(sc, kin, contacts)) return false;
   PostureRequest r;
   r.contacts = contacts;
   r.initial_guess = q;
@@ -188,16 +196,7 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
     // The surface's point nearest the start's base, in the surface's plane
     // (the base itself when it is over the surface).
     const Eigen::Vector2d local = (surf.frame.inverse() * sc.start.base_position).head<2>();
-    Eigen::Vector2d nearest_local = local;
-    if (!surf.polygon.contains(local)) {
-      double closest = std::numeric_limits<double>::infinity();
-      const auto& v = surf.polygon.vertices();
-      for (std::size_t k = 0; k < v.size(); ++k) {
-        const Eigen::Vector2d a = v[k], e = v[(k + 1) % v.size()] - a;
-        const Eigen::Vector2d p = a + std::clamp((local - a).dot(e) / e.squaredNorm(), 0.0, 1.0) * e;
-        if ((p - local).norm() < closest) closest = (p - local).norm(), nearest_local = p;
-      }
-    }
+    const Eigen::Vector2d nearest_local = surf.polygon.contains(local) ? local : surf.polygon.nearestBoundaryPoint(local);
     const Eigen::Vector2d nearest = (surf.frame * Eigen::Vector3d(nearest_local.x(), nearest_local.y(), 0)).head<2>();
     const double best = (nearest - from).norm();  // horizontal
     const Eigen::Vector2d dir = best > 1e-9 ? Eigen::Vector2d((nearest - from) / best) : Eigen::Vector2d::Zero();
@@ -213,14 +212,7 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
     q.base_position.head<2>() += candidates[i].shift;
     kin.setConfiguration(q);
     std::vector<ContactSpec> stance = sc.start_stance;
-    bool on = true;
-    for (auto& c : stance) {
-      const Surface& surf = sc.scene->surfaces()[c.surface];
-      c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
-      c.supporting = true;
-      on = on && surf.polygon.contains(Eigen::Vector2d(c.placement.x, c.placement.y));
-    }
-    if (!on) continue;
+    if (!placeWhereHeld(sc, kin, stance)) continue;
     // Lowered on the start's contacts: its goal link pulled to the bound, the
     // joints free to fold (a squat over the feet before the seat is touched).
     Configuration lowered = q;
