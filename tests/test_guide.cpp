@@ -27,6 +27,16 @@ void expectGuideFromTheStart(const Scenario& sc, GuideResult& r) {
   EXPECT_EQ(r.guide.key_postures.front().base_position, sc.start.base_position);
 }
 
+// Each contact placed where kin holds its spot, which must lie on its
+// surface (within 1 mm).
+void placeOnSurfaces(const Scenario& sc, const Kinematics& kin, std::vector<ContactSpec>& contacts) {
+  for (auto& c : contacts) {
+    const Surface& surf = sc.scene->surfaces()[c.surface];
+    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
+    EXPECT_LT(std::abs((surf.frame.inverse() * kin.spotPose(c.spot).translation()).z()), 1e-3) << sc.describe(c);
+  }
+}
+
 void expectGuideFor(const std::string& rel) {
   const Scenario sc = Scenario::load(test::sourcePath(rel));
   GuideResult r;
@@ -60,12 +70,7 @@ TEST(GuideAuthor, WetRampEndsOnTheStartStanceCarriedIntoTheGoal) {
   Kinematics kin(sc.robot);
   kin.setConfiguration(keys.back());
   std::vector<ContactSpec> carried = sc.start_stance;
-  for (auto& c : carried) {
-    const Surface& surf = sc.scene->surfaces()[c.surface];
-    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
-    const Eigen::Vector3d in_surface = surf.frame.inverse() * kin.spotPose(c.spot).translation();
-    EXPECT_LT(std::abs(in_surface.z()), 1e-3) << sc.describe(c);  // on its surface
-  }
+  placeOnSurfaces(sc, kin, carried);
   EXPECT_TRUE(sc.goal.satisfied(kin, carried));
   ValidityChecker checker(sc.robot, sc.scene);
   EXPECT_TRUE(checker.checkPosture(keys.back(), carried).valid());
@@ -91,11 +96,7 @@ TEST(GuideAuthor, SitDownEndsSeatedOnTheThighsOverTheFeetAndIsPlannedWithIt) {
     c.surface = base.scene->surfaceIndex("chair_seat");
     seated.push_back(c);
   }
-  for (auto& c : seated) {
-    const Surface& surf = base.scene->surfaces()[c.surface];
-    c.placement = projectOnSurface(surf, kin.spotPose(c.spot));
-    EXPECT_LT(std::abs((surf.frame.inverse() * kin.spotPose(c.spot).translation()).z()), 1e-3) << base.describe(c);
-  }
+  placeOnSurfaces(base, kin, seated);
   EXPECT_TRUE(base.goal.satisfied(kin, seated));
   ValidityChecker checker(base.robot, base.scene);
   EXPECT_TRUE(checker.checkPosture(end, seated).valid());
@@ -145,7 +146,7 @@ TEST(GuideAuthor, ACrouchOnTheFeetEndsLoweredOnTheStartStance) {
   Kinematics kin(sc.robot);
   kin.setConfiguration(r.guide.key_postures.back());
   std::vector<ContactSpec> feet = sc.start_stance;
-  for (auto& c : feet) c.placement = projectOnSurface(sc.scene->surfaces()[c.surface], kin.spotPose(c.spot));
+  placeOnSurfaces(sc, kin, feet);
   EXPECT_TRUE(sc.goal.satisfied(kin, feet));
   ValidityChecker checker(sc.robot, sc.scene);
   EXPECT_TRUE(checker.checkPosture(r.guide.key_postures.back(), feet).valid());
