@@ -84,8 +84,39 @@ Eigen::Isometry3d BodyPath::pose(double s) const {
     u = table_u_[i - 1] + f * (table_u_[i] - table_u_[i - 1]);
   }
   T.translation() = curvePoint(u);
+  if (!via_orientations_.empty()) {
+    // Between two consecutive waypoints, by the arc length from the first.
+    const int nseg = static_cast<int>(points_.size()) - 1;
+    const int seg = std::clamp(static_cast<int>(std::floor(u)), 0, nseg - 1);
+    const double l0 = table_len_[seg * kTableSteps], l1 = table_len_[(seg + 1) * kTableSteps];
+    const double f = l1 - l0 > 1e-9 ? std::clamp((c - l0) / (l1 - l0), 0.0, 1.0) : 0.5;
+    const Eigen::Quaterniond a = seg == 0 ? q0 : via_orientations_[seg - 1];
+    const Eigen::Quaterniond b = seg + 1 == nseg ? q1 : via_orientations_[seg];
+    T.linear() = a.slerp(f, b).toRotationMatrix();
+    return T;
+  }
   const double frac = curve_length_ > 1e-9 ? c / curve_length_ : 0.5;
   T.linear() = q0.slerp(std::clamp(frac, 0.0, 1.0), q1).toRotationMatrix();
+  return T;
+}
+
+BodyPath BodyPath::through(const std::vector<Eigen::Isometry3d>& waypoints) const {
+  std::vector<Eigen::Vector3d> vias;
+  for (const auto& w : waypoints) vias.push_back(w.translation());
+  BodyPath p(from_, to_, lift_, std::move(vias));
+  for (const auto& w : waypoints) p.via_orientations_.emplace_back(w.linear());
+  return p;
+}
+
+Eigen::Isometry3d BodyPath::splineStart() const {
+  Eigen::Isometry3d T = from_.pose;
+  T.translation() = points_.front();
+  return T;
+}
+
+Eigen::Isometry3d BodyPath::splineEnd() const {
+  Eigen::Isometry3d T = to_.pose;
+  T.translation() = points_.back();
   return T;
 }
 

@@ -47,18 +47,27 @@ class BodyPath {
   // `across` sideways (as bridged's): a detour that turns early or late, as a
   // foot that must first step sideways past a post and then back.
   BodyPath detoured(double at, double across) const;
+  // The same ends through planned waypoints (positions and orientations),
+  // the orientation slerped between consecutive ones instead of from end to
+  // end: a path planned around the obstacles (body_path_planner.h).
+  BodyPath through(const std::vector<Eigen::Isometry3d>& waypoints) const;
   const std::vector<Eigen::Vector3d>& vias() const { return vias_; }
+  // Where the spline starts and ends (the tops of the straight parts), with
+  // the end orientations: what a planned path connects.
+  Eigen::Isometry3d splineStart() const;
+  Eigen::Isometry3d splineEnd() const;
+  // Along the mean of the end normals (or world z): where a repair raises the path.
+  Eigen::Vector3d up() const;
 
  private:
   Eigen::Vector3d curvePoint(double u) const;  // u in [0, number of spline segments]
-  // Along the mean of the end normals (or world z): where a repair raises the path.
-  Eigen::Vector3d up() const;
   // A repair's via-point: at fraction `at` of the spline's chord, `height` above its higher end, `across` sideways.
   Eigen::Vector3d viaPoint(double at, double height, double across) const;
   BodyPathEnd from_, to_;
   double lift_;
   double lift0_ = 0, lift1_ = 0;
   std::vector<Eigen::Vector3d> vias_;
+  std::vector<Eigen::Quaterniond> via_orientations_;  // empty: slerp from end to end
   std::vector<Eigen::Vector3d> points_, tangents_;  // spline knots and their tangents
   std::vector<double> table_u_, table_len_;         // arc-length table of the spline
   double curve_length_ = 0;

@@ -92,6 +92,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.air_orientation_tolerance = opt.air_orientation_tolerance;
   to.repair_attempts = opt.repair_attempts;
   to.repair_step = opt.repair_step;
+  to.plan_body_path = opt.plan_body_path;
   to.refine_depth = opt.refine_depth;
   to.posture.max_iterations = opt.posture_iterations;
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load

@@ -28,6 +28,7 @@ struct InterpolatorOptions {
   double air_orientation_tolerance = 0.3;  // the moving body's orientation in the air (transition.h)
   int repair_attempts = 4;       // raised or sideways via-points tried on a colliding path
   double repair_step = 0.05;     // m: via-point height added per attempt
+  bool plan_body_path = true;    // after them, the body's path planned with OMPL (body_path_planner.h)
   int refine_depth = 3;
   // Check every output sample with the validity contract (and refine where
   // one fails). Off, only knots and segment middles are checked: for

@@ -6,6 +6,7 @@
 #include <limits>
 #include <set>
 
+#include "interpolator/body_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/common/geometry.h"
 #include "planner/collision/collision_model.h"
@@ -42,33 +43,6 @@ std::string pair(int a, int b) { return "stances " + std::to_string(a) + " -> " 
 
 double distance(const Configuration& a, const Configuration& b) {
   return difference(a, b).cwiseAbs().maxCoeff();
-}
-
-// A shape at its world pose.
-using PlacedShape = std::pair<const CollisionShape*, Eigen::Isometry3d>;
-
-// The least distance from the moving body's link, carried rigidly along the
-// path's spline (the straight parts are common to every repair), to any
-// obstacle and to the links held on their contacts (`held`: a foot stepping
-// past the other): how well a repair's path clears them, before any posture.
-double sweepClearance(const BodyPath& path, const RobotModel& robot, const Scene& scene, int spot,
-                      const std::vector<PlacedShape>& held) {
-  constexpr int kSamples = 32;
-  const ContactSpot& sp = robot.spots()[spot];
-  const Eigen::Isometry3d spot_in_link = sp.frame.inverse();
-  double clearance = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= kSamples; ++i) {
-    const double s = static_cast<double>(i) / kSamples;
-    if (path.straightAt(s)) continue;
-    const Eigen::Isometry3d link = path.pose(s) * spot_in_link;
-    for (const auto& shape : robot.links()[sp.link].shapes)
-      for (const auto& ob : scene.obstacles())
-        clearance = std::min(clearance, shapeDistance(shape, link * shape.pose, ob.shape, ob.shape.pose));
-    for (const auto& shape : robot.links()[sp.link].shapes)
-      for (const auto& [other, pose] : held)
-        clearance = std::min(clearance, shapeDistance(shape, link * shape.pose, *other, pose));
-  }
-  return clearance;
 }
 
 }  // namespace
@@ -321,12 +295,37 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
           }
         }
       }
-      if (solveMove(plan, d, p, at)) {
+      if (solveMove(plan, d, p, opt_.air_orientation_tolerance, at)) {
         out.ok = true;
         out.repaired = attempt > 0;
         break;
       }
       reasons += (reasons.empty() ? "" : "; ") + how + ": " + at.reason;
+    }
+    // Last, the body's path planned with OMPL: through a gap no spline
+    // passes, its orientation planned with it and followed closely (the
+    // orientation left free, the knots turn the body one way, then the other).
+    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.plan_body_path) {
+      at.pieces.clear();
+      // The body passes every link outside its own limb where the first
+      // witness has them: the other foot, and the shank above it that a foot
+      // stepping over that foot would strike.
+      const RobotModel& m = *sc_.robot;
+      const int root = m.limbRootJoint(m.spots()[d.spot].link);
+      std::vector<PlacedShape> others;
+      kin_.setConfiguration(plan.stances[d.from].configuration);
+      for (const auto& l : m.links())
+        if (root >= 0 ? !m.jointMovesLink(root, l.index) : l.index != m.spots()[d.spot].link)
+          for (const auto& shape : l.shapes) others.push_back({&shape, kin_.linkPose(l.index) * shape.pose});
+      const BodyPathPlan planned = planBodyPath(path, m, *sc_.scene, d.spot, others);
+      if (!planned.path) {
+        reasons += "; " + planned.reason;
+      } else if (solveMove(plan, d, *planned.path, opt_.planned_orientation_tolerance, at)) {
+        out.ok = out.repaired = true;
+      } else {
+        reasons += "; a path planned by OMPL through " + std::to_string(planned.path->vias().size()) +
+                   " waypoints: " + at.reason;
+      }
     }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
@@ -398,7 +397,8 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   return true;
 }
 
-bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, Attempt& at) {
+bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path,
+                                 double orientation_tolerance, Attempt& at) {
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   std::vector<int> touch;
@@ -435,7 +435,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     t.touch_obstacles = touch;
     std::vector<PoseTarget> targets;
     if (!path.straightAt(s)) {  // in the air
-      t.orientation_tolerance = opt_.air_orientation_tolerance;
+      t.orientation_tolerance = orientation_tolerance;
       targets.push_back(t);
       // Failing that, within straight_slack of it: a body that had to pivot
       // off its surface (held at its other end) cannot follow every point of
@@ -463,7 +463,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
         loose.orientation_tolerance = kTouchTilt;
       } else {
         loose.position_tolerance = Eigen::Vector3d(opt_.straight_slack, opt_.straight_slack, 0);
-        loose.orientation_tolerance = opt_.air_orientation_tolerance;
+        loose.orientation_tolerance = orientation_tolerance;
       }
       targets.push_back(loose);
     }

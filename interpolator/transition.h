@@ -86,6 +86,10 @@ struct TransitionOptions {
   double straight_slack = 0.005;
   int repair_attempts = 4;
   double repair_step = 0.05;         // m: via-point height added per attempt
+  // After the attempts, the body's path planned with OMPL (body_path_planner.h),
+  // its orientation followed within this bound on each row.
+  bool plan_body_path = true;
+  double planned_orientation_tolerance = 0.05;
   int refine_depth = 3;              // halvings of a segment whose inside fails the check
   int segment_checks = 1;            // points checked inside each segment before timing (its middle)
   // After timing, every sample the piece will give is checked, and refined
@@ -116,7 +120,9 @@ class TransitionSolver {
   struct Attempt;
   // `follow`: the cost also holds each knot near the previous one.
   bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, Attempt& at);
-  bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, Attempt& at);
+  // `orientation_tolerance`: the body's orientation off its path's in the air (PoseTarget).
+  bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, double orientation_tolerance,
+                 Attempt& at);
 
   const Scenario& sc_;
   TransitionOptions opt_;

@@ -8,6 +8,7 @@
 #include <atomic>
 
 #include "interpolator/body_path.h"
+#include "interpolator/body_path_planner.h"
 #include "interpolator/interpolator.h"
 #include "interpolator/time_law.h"
 #include "planner/check/trajectory_check.h"
@@ -207,6 +208,82 @@ TEST(BodyPath, DetoursPassBeside) {
   // The ends are the witnesses' poses, whatever the detour.
   EXPECT_LT((early.pose(1).translation() - b.pose.translation()).norm(), 1e-12);
   EXPECT_LT(early.pose(0).translation().norm(), 1e-12);
+}
+
+TEST(BodyPath, ThroughWaypointsPassesEachWithItsOrientation) {
+  BodyPathEnd a, b;
+  a.normal = b.normal = Eigen::Vector3d::UnitZ();
+  b.pose.translation() = Eigen::Vector3d(0.4, 0, 0);
+  b.pose.linear() = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const BodyPath p(a, b, 0.03);
+  std::vector<Eigen::Isometry3d> w(2, Eigen::Isometry3d::Identity());
+  w[0].translation() = Eigen::Vector3d(0.1, 0.1, 0.1);
+  w[0].linear() = Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  w[1].translation() = Eigen::Vector3d(0.3, 0.1, 0.1);
+  w[1].linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const BodyPath t = p.through(w);
+  ASSERT_EQ(t.vias().size(), 2u);
+  // The straight parts and the ends are the designed path's.
+  EXPECT_LT((t.pose(0).translation() - a.pose.translation()).norm(), 1e-12);
+  EXPECT_LT((t.pose(1).translation() - b.pose.translation()).norm(), 1e-12);
+  EXPECT_LT((t.splineStart().translation() - Eigen::Vector3d(0, 0, 0.03)).norm(), 1e-12);
+  EXPECT_LT((t.splineEnd().translation() - Eigen::Vector3d(0.4, 0, 0.03)).norm(), 1e-12);
+  // Where the path passes each waypoint, the body has the waypoint's orientation
+  // (not the ends' slerp: -0.4 rad lies outside [0, 0.2]); between samples it turns little.
+  const int n = 2000;
+  std::vector<double> nearest(2, 1e9), angle_there(2, 1e9);
+  double largest_turn = 0;
+  for (int i = 0; i <= n; ++i) {
+    const Eigen::Isometry3d T = t.pose(static_cast<double>(i) / n);
+    if (i > 0)
+      largest_turn = std::max(largest_turn, Eigen::AngleAxisd(T.linear().transpose() * t.pose((i - 1.0) / n).linear()).angle());
+    for (int k = 0; k < 2; ++k) {
+      const double d = (T.translation() - w[k].translation()).norm();
+      if (d < nearest[k]) nearest[k] = d, angle_there[k] = Eigen::AngleAxisd(T.linear().transpose() * w[k].linear()).angle();
+    }
+  }
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_LT(nearest[k], 1e-3) << k;
+    EXPECT_LT(angle_there[k], 0.01) << k;
+  }
+  EXPECT_LT(largest_turn, 0.01);
+}
+
+TEST(BodyPathPlanner, PlansAFootOverABoxClearOfItTheSameEachTime) {
+  // The right foot stepping 0.28 m forward over the low box: the designed
+  // path cuts the box; the planned one clears it by the clearance asked
+  // for, and the left foot too. Without room to rise or turn aside there is
+  // no path, and the reason says so.
+  const Scenario& sc = boxScenario();
+  const int r = sc.robot->spotIndex("r_sole"), l = sc.robot->spotIndex("l_sole");
+  BodyPathEnd e0, e1;
+  e0.pose = spotAt(sc, sc.start, r);
+  e1.pose = e0.pose;
+  e1.pose.translation().x() += 0.28;
+  e0.normal = e1.normal = Eigen::Vector3d::UnitZ();
+  const BodyPath designed(e0, e1, 0.03);
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  std::vector<PlacedShape> held;
+  const int left_foot = sc.robot->spots()[l].link;
+  for (const auto& shape : sc.robot->links()[left_foot].shapes) held.push_back({&shape, k.linkPose(left_foot) * shape.pose});
+  EXPECT_LT(sweepClearance(designed, *sc.robot, *sc.scene, r, held), 0.0);
+  BodyPathPlanOptions o;
+  const BodyPathPlan p = planBodyPath(designed, *sc.robot, *sc.scene, r, held, o);
+  ASSERT_TRUE(p.path) << p.reason;
+  EXPECT_FALSE(p.path->vias().empty());
+  EXPECT_GE(sweepClearance(*p.path, *sc.robot, *sc.scene, r, held), 0.5 * o.clearance);
+  EXPECT_LT((p.path->pose(1).translation() - e1.pose.translation()).norm(), 1e-12);
+  const BodyPathPlan again = planBodyPath(designed, *sc.robot, *sc.scene, r, held, o);
+  ASSERT_TRUE(again.path);
+  ASSERT_EQ(again.path->vias().size(), p.path->vias().size());
+  for (std::size_t i = 0; i < p.path->vias().size(); ++i) EXPECT_EQ(again.path->vias()[i], p.path->vias()[i]) << i;
+  o.room = 0;
+  o.rise = 0;
+  o.max_checks = 2000;
+  const BodyPathPlan none = planBodyPath(designed, *sc.robot, *sc.scene, r, held, o);
+  EXPECT_FALSE(none.path);
+  EXPECT_NE(none.reason.find("no path"), std::string::npos) << none.reason;
 }
 
 // --- The time law -----------------------------------------------------------
@@ -506,6 +583,29 @@ TEST(Interpolator, FootDetoursPastTheChairLegBesideTheOtherFoot) {
   EXPECT_EQ(r.trajectory.stats.repairs, 1);
   expectValid(r.trajectory, sc);
   opt.repair_attempts = 0;
+  const InterpolationResult u = interpolate(plan, sc, opt);
+  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
+  EXPECT_NE(u.reason.find("stances 0 -> 2"), std::string::npos) << u.reason;
+}
+
+TEST(Interpolator, FootPassesBetweenTheChairLegAndTheOtherFootOnAPlannedPath) {
+  // From a plan made with the OMPL guide: the right foot steps back from
+  // beside the chair's front left leg, its heel 5 mm from it, to beside the
+  // seat, through a gap 0.165 m wide between that leg and the left foot for a
+  // foot 0.138 m wide. Every spline cuts the leg or the other foot, or leaves
+  // the foot's turn to the knots, which turn its toes one way and then the
+  // other (a hip yaw jump of 0.4 rad between two knots 2 mm apart); the
+  // path planned with OMPL turns the foot with the gap.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_step.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 3u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+  opt.plan_body_path = false;
   const InterpolationResult u = interpolate(plan, sc, opt);
   EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
   EXPECT_NE(u.reason.find("stances 0 -> 2"), std::string::npos) << u.reason;

@@ -555,8 +555,12 @@ TEST(QuasiStaticCheck, WarmStartedChecksAgreeWithColdOnes) {
     ++checks;
     infeasible += !b.feasible;
     ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
-    if (std::isfinite(b.margin)) EXPECT_NEAR(a.margin, b.margin, 1e-6 * (1 + std::abs(b.margin))) << checks;
-    if (b.feasible) EXPECT_NEAR(a.worst_torque_ratio, b.worst_torque_ratio, 1e-5) << checks;  // Clp's tolerances
+    if (std::isfinite(b.margin)) {
+      EXPECT_NEAR(a.margin, b.margin, 1e-6 * (1 + std::abs(b.margin))) << checks;
+    }
+    if (b.feasible) {
+      EXPECT_NEAR(a.worst_torque_ratio, b.worst_torque_ratio, 1e-5) << checks;  // Clp's tolerances
+    }
   };
   for (std::size_t i = 0; i + 1 < plan.stances.size(); i += 3) {
     const auto stance = plan.stances[i].specs();

@@ -155,6 +155,13 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
       m->moves_[j][l.index] = true;
       m->subtree_mass_[j] += l.mass;
     }
+  // A limb hangs from the last joint, on the way from the base, whose parent link branches.
+  std::vector<int> children(m->links_.size(), 0);
+  for (const auto& j : m->joints_) ++children[j.parent_link];
+  m->limb_root_.assign(m->links_.size(), -1);
+  for (const auto& l : m->links_)
+    for (int j : m->ancestors_[l.index])
+      if (children[m->joints_[j].parent_link] > 1) m->limb_root_[l.index] = j;
 
   // Simbody: a free-flying base and one pin per joint.
   Impl& S = *m->impl_;

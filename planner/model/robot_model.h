@@ -83,6 +83,10 @@ class RobotModel {
   const std::vector<int>& ancestorJoints(int link) const { return ancestors_[link]; }  // base to link
   bool jointMovesLink(int joint, int link) const { return moves_[joint][link]; }
   double subtreeMass(int joint) const { return subtree_mass_[joint]; }  // links moved by the joint
+  // The joint a link's limb hangs from: the last one on the way from the base
+  // whose parent link branches (a leg's hip yaw, an arm's shoulder); -1 for
+  // the trunk's links above every branch.
+  int limbRootJoint(int link) const { return limb_root_[link]; }
 
   int jointIndex(const std::string& name) const;  // -1 if unknown
   int linkIndex(const std::string& name) const;
@@ -117,6 +121,7 @@ class RobotModel {
   std::vector<std::vector<int>> ancestors_;
   std::vector<std::vector<bool>> moves_;
   std::vector<double> subtree_mass_;
+  std::vector<int> limb_root_;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -119,22 +119,12 @@ struct ContactPlanner::Impl {
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
 
-  // Per spot, the joint its limb hangs from: the last joint on the way from
-  // the spot's link to the base whose parent link branches (a leg's hip yaw,
-  // an arm's shoulder).
+  // Per spot, the joint its limb hangs from (RobotModel::limbRootJoint).
   std::vector<int> limb;
 
   Impl(const Scenario& s, PlannerParameters params)
       : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), rng(s.seed) {
-    const RobotModel& m = *s.robot;
-    std::vector<int> children(m.numLinks(), 0);
-    for (const auto& j : m.joints()) ++children[j.parent_link];
-    for (const auto& spot : m.spots()) {
-      int root = -1;
-      for (int j : m.ancestorJoints(spot.link))  // base to link
-        if (children[m.joints()[j].parent_link] > 1) root = j;
-      limb.push_back(root);
-    }
+    for (const auto& spot : s.robot->spots()) limb.push_back(s.robot->limbRootJoint(spot.link));
     for (int t = 0; t < std::max(1, p.threads); ++t)
       pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
     if (p.guide_potential) {
