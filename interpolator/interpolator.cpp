@@ -93,6 +93,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.repair_attempts = opt.repair_attempts;
   to.repair_step = opt.repair_step;
   to.plan_body_path = opt.plan_body_path;
+  to.free_limb_paths = opt.free_limb_paths;
   to.refine_depth = opt.refine_depth;
   to.posture.max_iterations = opt.posture_iterations;
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load

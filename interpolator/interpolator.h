@@ -29,6 +29,7 @@ struct InterpolatorOptions {
   int repair_attempts = 4;       // raised or sideways via-points tried on a colliding path
   double repair_step = 0.05;     // m: via-point height added per attempt
   bool plan_body_path = true;    // after them, the body's path planned with OMPL (body_path_planner.h)
+  bool free_limb_paths = true;   // then all again, the free limbs' ends on paths of their own (transition.h)
   int refine_depth = 3;
   // Check every output sample with the validity contract (and refine where
   // one fails). Off, only knots and segment middles are checked: for

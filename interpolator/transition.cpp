@@ -265,67 +265,74 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       for (const auto& shape : sc_.robot->links()[link].shapes) held.push_back({&shape, kin_.linkPose(link) * shape.pose});
     }
     std::string reasons;
-    for (int attempt = 0; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt) {
-      at.pieces.clear();
-      const double h = attempt * opt_.repair_step;
-      // A repair: the bridge raised by h, or a detour h to either side (the
-      // bridge moved sideways, or one via-point a quarter, half or three
-      // quarters of the way), whichever carries the body farthest from the
-      // obstacles and the held links (the raised one on a tie). Raising alone
-      // does not get a foot past a post; a foot between a post and the other
-      // foot has to step sideways first, then back.
-      BodyPath p = path;
-      std::string how = "as planned";
-      if (attempt > 0) {
-        double best = -std::numeric_limits<double>::infinity();
-        auto consider = [&](BodyPath candidate, std::string label) {
-          const double c = sweepClearance(candidate, *sc_.robot, *sc_.scene, d.spot, held);
-          if (c > best + 1e-9) best = c, p = std::move(candidate), how = std::move(label);
-        };
-        char buf[96];
-        std::snprintf(buf, sizeof buf, "via-point %.2f m up", h);
-        consider(path.raised(h), buf);
-        for (double side : {1.0, -1.0}) {
-          const char* name = side > 0 ? "left" : "right";
-          std::snprintf(buf, sizeof buf, "detour %.2f m %s", h, name);
-          consider(path.bridged(0, side * h), buf);
-          for (double f : {0.25, 0.5, 0.75}) {
-            std::snprintf(buf, sizeof buf, "detour %.2f m %s at %.2f of the way", h, name, f);
-            consider(path.detoured(f, side * h), buf);
+    // The body's path planned with OMPL, once, when the splines have failed.
+    std::optional<BodyPathPlan> planned;
+    auto tryPaths = [&](const std::vector<FreeEnd>* free, const std::string& label) {
+      for (int attempt = 0; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt) {
+        at.pieces.clear();
+        const double h = attempt * opt_.repair_step;
+        // A repair: the bridge raised by h, or a detour h to either side (the
+        // bridge moved sideways, or one via-point a quarter, half or three
+        // quarters of the way), whichever carries the body farthest from the
+        // obstacles and the held links (the raised one on a tie). Raising alone
+        // does not get a foot past a post; a foot between a post and the other
+        // foot has to step sideways first, then back.
+        BodyPath p = path;
+        std::string how = "as planned";
+        if (attempt > 0) {
+          double best = -std::numeric_limits<double>::infinity();
+          auto consider = [&](BodyPath candidate, std::string label) {
+            const double c = sweepClearance(candidate, *sc_.robot, *sc_.scene, d.spot, held);
+            if (c > best + 1e-9) best = c, p = std::move(candidate), how = std::move(label);
+          };
+          char buf[96];
+          std::snprintf(buf, sizeof buf, "via-point %.2f m up", h);
+          consider(path.raised(h), buf);
+          for (double side : {1.0, -1.0}) {
+            const char* name = side > 0 ? "left" : "right";
+            std::snprintf(buf, sizeof buf, "detour %.2f m %s", h, name);
+            consider(path.bridged(0, side * h), buf);
+            for (double f : {0.25, 0.5, 0.75}) {
+              std::snprintf(buf, sizeof buf, "detour %.2f m %s at %.2f of the way", h, name, f);
+              consider(path.detoured(f, side * h), buf);
+            }
           }
         }
+        if (solveMove(plan, d, p, opt_.air_orientation_tolerance, free, at)) {
+          out.repaired = attempt > 0 || free;
+          return true;
+        }
+        reasons += (reasons.empty() ? "" : "; ") + label + how + ": " + at.reason;
       }
-      if (solveMove(plan, d, p, opt_.air_orientation_tolerance, at)) {
-        out.ok = true;
-        out.repaired = attempt > 0;
-        break;
-      }
-      reasons += (reasons.empty() ? "" : "; ") + how + ": " + at.reason;
-    }
-    // Last, the body's path planned with OMPL: through a gap no spline
-    // passes, its orientation planned with it and followed closely (the
-    // orientation left free, the knots turn the body one way, then the other).
-    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.plan_body_path) {
+      // Last, the body's path planned with OMPL: through a gap no spline
+      // passes, its orientation planned with it and followed closely (the
+      // orientation left free, the knots turn the body one way, then the
+      // other). The body passes every link outside its own limb where the
+      // first witness has them: the other foot, and the shank above it that a
+      // foot stepping over that foot would strike.
+      if (at.cancelled || opt_.repair_attempts == 0 || !opt_.plan_body_path) return false;
       at.pieces.clear();
-      // The body passes every link outside its own limb where the first
-      // witness has them: the other foot, and the shank above it that a foot
-      // stepping over that foot would strike.
-      const RobotModel& m = *sc_.robot;
-      const int root = m.limbRootJoint(m.spots()[d.spot].link);
-      std::vector<PlacedShape> others;
-      kin_.setConfiguration(plan.stances[d.from].configuration);
-      for (const auto& l : m.links())
-        if (root >= 0 ? !m.jointMovesLink(root, l.index) : l.index != m.spots()[d.spot].link)
-          for (const auto& shape : l.shapes) others.push_back({&shape, kin_.linkPose(l.index) * shape.pose});
-      const BodyPathPlan planned = planBodyPath(path, m, *sc_.scene, d.spot, others);
-      if (!planned.path) {
-        reasons += "; " + planned.reason;
-      } else if (solveMove(plan, d, *planned.path, opt_.planned_orientation_tolerance, at)) {
-        out.ok = out.repaired = true;
-      } else {
-        reasons += "; a path planned by OMPL through " + std::to_string(planned.path->vias().size()) +
-                   " waypoints: " + at.reason;
+      if (!planned)
+        planned = planBodyPath(path, *sc_.robot, *sc_.scene, d.spot, outsideLimb(plan.stances[d.from].configuration, d.spot));
+      if (!planned->path) {
+        reasons += "; " + label + planned->reason;
+        return false;
       }
+      if (solveMove(plan, d, *planned->path, opt_.planned_orientation_tolerance, free, at)) {
+        out.repaired = true;
+        return true;
+      }
+      reasons += "; " + label + "a path planned by OMPL through " + std::to_string(planned->path->vias().size()) +
+                 " waypoints: " + at.reason;
+      return false;
+    };
+    out.ok = tryPaths(nullptr, "");
+    // Then each again with the free limbs on paths of their own (freeEnds):
+    // a free foot that the witnesses' interpolation swings into the other
+    // foot or a chair's leg.
+    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths) {
+      const std::vector<FreeEnd> free = freeEnds(plan, d);
+      if (!free.empty()) out.ok = tryPaths(&free, "with the free limbs on their own paths, ");
     }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
@@ -397,8 +404,68 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   return true;
 }
 
+struct TransitionSolver::FreeEnd {
+  int spot;
+  BodyPath path;
+};
+
+// The free limbs (no contact on them, and not the moving body's): each one's
+// end (its most distal spot: a foot, a palm) on a path of its own from where
+// the first witness has it to where the last does, straight, or planned
+// around what the straight line cuts (a free foot the witnesses move from
+// beside the other foot to behind it). Left to the witnesses' interpolation
+// alone, in joint space, it can swing into an obstacle, slide along it from
+// knot to knot, and jump past it.
+std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& plan, const TransitionDesign& d) {
+  const Configuration& q0 = plan.stances[d.from].configuration;
+  const Configuration& q1 = plan.stances[d.to].configuration;
+  const RobotModel& m = *sc_.robot;
+  auto limbOf = [&](int spot) { return m.limbRootJoint(m.spots()[spot].link); };
+  auto depth = [&](int spot) { return m.ancestorJoints(m.spots()[spot].link).size(); };
+  std::vector<int> ends;  // per free limb, its most distal spot
+  for (int i = 0; i < static_cast<int>(m.spots().size()); ++i) {
+    const int root = limbOf(i);
+    bool held = root < 0 || root == limbOf(d.spot);
+    for (const auto& c : d.motion_contacts) held = held || limbOf(c.spot) == root;
+    if (held) continue;
+    const auto same = std::find_if(ends.begin(), ends.end(), [&](int e) { return limbOf(e) == root; });
+    if (same == ends.end())
+      ends.push_back(i);
+    else if (depth(i) > depth(*same))
+      *same = i;
+  }
+  std::vector<FreeEnd> out;
+  const BodyPathPlanOptions po;
+  for (int e : ends) {
+    BodyPathEnd a, b;
+    kin_.setConfiguration(q0);
+    a.pose = kin_.spotPose(e);
+    kin_.setConfiguration(q1);
+    b.pose = kin_.spotPose(e);
+    BodyPath path(a, b, 0);
+    const std::vector<PlacedShape> others = outsideLimb(q0, e);
+    if (sweepClearance(path, m, *sc_.scene, e, others) < po.clearance) {
+      BodyPathPlan planned = planBodyPath(path, m, *sc_.scene, e, others, po);
+      if (planned.path) path = std::move(*planned.path);
+    }
+    out.push_back({e, std::move(path)});
+  }
+  return out;
+}
+
+std::vector<PlacedShape> TransitionSolver::outsideLimb(const Configuration& q, int spot) {
+  const RobotModel& m = *sc_.robot;
+  const int link = m.spots()[spot].link, root = m.limbRootJoint(link);
+  std::vector<PlacedShape> out;
+  kin_.setConfiguration(q);
+  for (const auto& l : m.links())
+    if (root >= 0 ? !m.jointMovesLink(root, l.index) : l.index != link)
+      for (const auto& shape : l.shapes) out.push_back({&shape, kin_.linkPose(l.index) * shape.pose});
+  return out;
+}
+
 bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path,
-                                 double orientation_tolerance, Attempt& at) {
+                                 double orientation_tolerance, const std::vector<FreeEnd>* free_ends, Attempt& at) {
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   std::vector<int> touch;
@@ -417,7 +484,10 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     // squared distance to the neighbouring knot (the guess), i.e. the distance
     // to their midpoint: the knots stay on one branch of the body's inverse
     // kinematics instead of jumping between them.
-    const auto cost = std::make_shared<ReferencePostureCost>(lerp(guess, ref, 0.5));
+    std::vector<ReferencePostureCost::SpotTarget> free_targets;
+    if (free_ends)
+      for (const auto& f : *free_ends) free_targets.push_back({f.spot, f.path.pose(s).translation(), opt_.free_limb_weight});
+    const auto cost = std::make_shared<ReferencePostureCost>(lerp(guess, ref, 0.5), 1.0, 10.0, 1.0, free_targets);
     auto attempt = [&](const PoseTarget& t, const Configuration& g) {
       PostureRequest r;
       r.contacts = d.motion_contacts;

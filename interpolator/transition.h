@@ -34,7 +34,11 @@
 // cannot fix) is repaired, farther on each attempt, by raising its spline into
 // a bridge or by a detour to either side, whichever carries the moving link
 // (rigidly, along the spline) farthest from the obstacles and the links held
-// on their contacts.
+// on their contacts; then by a path planned with OMPL for the body alone
+// (body_path_planner.h), its orientation followed closely; then all of these
+// again with the end of each free limb (a foot or a hand with no contact)
+// pulled along a path of its own between its witness positions, where the
+// witnesses' interpolation swings it into an obstacle.
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -42,6 +46,7 @@
 #include <vector>
 
 #include "interpolator/body_path.h"
+#include "interpolator/body_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/check/validity.h"
 #include "planner/plan/plan.h"
@@ -90,6 +95,10 @@ struct TransitionOptions {
   // its orientation followed within this bound on each row.
   bool plan_body_path = true;
   double planned_orientation_tolerance = 0.05;
+  // Then the same attempts with the end of each free limb (no contact on it)
+  // pulled along a path of its own, with this weight (ReferencePostureCost::SpotTarget).
+  bool free_limb_paths = true;
+  double free_limb_weight = 100;
   int refine_depth = 3;              // halvings of a segment whose inside fails the check
   int segment_checks = 1;            // points checked inside each segment before timing (its middle)
   // After timing, every sample the piece will give is checked, and refined
@@ -121,8 +130,14 @@ class TransitionSolver {
   // `follow`: the cost also holds each knot near the previous one.
   bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, Attempt& at);
   // `orientation_tolerance`: the body's orientation off its path's in the air (PoseTarget).
+  struct FreeEnd;
+  // `free_ends`: the end of each limb without contacts pulled along a path
+  // of its own between its witness positions (none: nullptr).
   bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, double orientation_tolerance,
-                 Attempt& at);
+                 const std::vector<FreeEnd>* free_ends, Attempt& at);
+  std::vector<FreeEnd> freeEnds(const Plan& plan, const TransitionDesign& d);
+  // The shapes of the links outside `spot`'s limb at q (all but its link, for a spot on the trunk).
+  std::vector<PlacedShape> outsideLimb(const Configuration& q, int spot);
 
   const Scenario& sc_;
   TransitionOptions opt_;

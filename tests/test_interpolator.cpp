@@ -611,6 +611,28 @@ TEST(Interpolator, FootPassesBetweenTheChairLegAndTheOtherFootOnAPlannedPath) {
   EXPECT_NE(u.reason.find("stances 0 -> 2"), std::string::npos) << u.reason;
 }
 
+TEST(Interpolator, FreeFootKeepsToAPathOfItsOwnWhileTheHandReachesTheTable) {
+  // From the same plan: standing on the left foot, the right palm reaches
+  // the table top from below its edge while the free right foot goes from
+  // beside the left foot to behind it. Interpolated in joint space the free
+  // foot swings into the chair's back left leg or the left foot, slides along
+  // it from knot to knot and jumps past it, whichever path the palm takes;
+  // its end on a path of its own (planned around the left foot) it does not.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_reach.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+  opt.free_limb_paths = false;
+  const InterpolationResult u = interpolate(plan, sc, opt);
+  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
+  EXPECT_NE(u.reason.find("stances 0 -> 1"), std::string::npos) << u.reason;
+}
+
 TEST(Interpolator, BadInputAndCancellation) {
   const Scenario& sc = floorScenario();
   Plan plan = stepPlan(sc, 0.15);

@@ -117,6 +117,43 @@ TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
   }
 }
 
+TEST(PostureProblem, SpotTargetsOfTheReferenceCostMatchFiniteDifferences) {
+  // The reference cost with two spots pulled toward world points (a free
+  // foot and a free hand kept on their paths by the interpolator).
+  const Scenario& sc = chair();
+  auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
+  PostureRequest r = wristOnTable(sc);
+  std::vector<ReferencePostureCost::SpotTarget> targets(2);
+  targets[0].spot = sc.robot->spotIndex("r_sole");
+  targets[0].point = Eigen::Vector3d(0.1, -0.2, 0.05);
+  targets[0].weight = 100;
+  targets[1].spot = sc.robot->spotIndex("r_palm");
+  targets[1].point = Eigen::Vector3d(0.3, -0.3, 0.7);
+  targets[1].weight = 30;
+  r.cost = std::make_shared<ReferencePostureCost>(sc.start, 1.0, 10.0, 1.0, targets);
+  PostureProblem p(sc.robot, sc.scene, cm, r, {});
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, 0.05);
+  Eigen::VectorXd x = p.initialPoint();
+  for (int i = 0; i < sc.robot->tangentSize(); ++i) x[i] += n(rng);
+  const Eigen::VectorXd g = p.costGradient(x);
+  Eigen::VectorXd gn(x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    const double h = 1e-6;
+    Eigen::VectorXd a = x, b = x;
+    a[i] += h;
+    b[i] -= h;
+    gn[i] = (p.cost(a) - p.cost(b)) / (2 * h);
+  }
+  EXPECT_LT(test::relativeError(g, gn), 1e-6);
+  // The targets count: without them the cost and its gradient differ.
+  PostureRequest plain = r;
+  plain.cost = std::make_shared<ReferencePostureCost>(sc.start);
+  PostureProblem q(sc.robot, sc.scene, cm, plain, {});
+  EXPECT_GT(p.cost(x) - q.cost(x), 1.0);
+  EXPECT_GT((g - q.costGradient(x)).norm(), 1.0);
+}
+
 TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
   // Every block but the collision rows' curvature (left out, multipliers zero
   // here) and the base rotation's own block (second-order parameterization
