@@ -99,6 +99,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
   to.posture.ipopt_options = opt.posture_ipopt_options;
+  to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap};
   to.verify_samples = opt.verify_samples;
   TransitionSolver solver(sc, to);

@@ -148,6 +148,7 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   if (opt_.hessian != "diagonal" && opt_.hessian != "lbfgs" && opt_.hessian != "analytic")
     throw std::invalid_argument("PostureGeneratorOptions::hessian: expected lbfgs, analytic or diagonal");
   o->SetStringValue("hessian_approximation", opt_.hessian == "lbfgs" ? "limited-memory" : "exact");
+  if (opt_.hessian == "lbfgs" && opt_.lbfgs_in_kkt) o->SetStringValue("limited_memory_aug_solver", "extended");
   o->SetStringValue("mu_strategy", "adaptive");
   o->SetNumericValue("tol", opt_.tolerance);
   o->SetNumericValue("constr_viol_tol", opt_.tolerance);

@@ -22,6 +22,15 @@ struct PostureGeneratorOptions {
   // best measured by bench_posture), "analytic" (PostureProblem's Hessian of
   // the Lagrangian) or "diagonal" (the cost's, constant).
   std::string hessian = "lbfgs";
+  // L-BFGS's low-rank part as extra rows of the KKT system, factorized with
+  // it once per iteration, instead of Sherman-Morrison's dozen MUMPS solves
+  // per iteration around it (Ipopt's limited_memory_aug_solver=extended):
+  // each MUMPS call has a fixed cost that these small systems do not
+  // amortize. bench_posture: successes 1.2-1.8 times faster at the same
+  // iterations, failures 1.5-1.8. Off by default: the witnesses differ, and
+  // the chair's search, chaotic in them, then did not solve in 3,000 nodes
+  // (README "Posture generator"); the interpolator turns it on.
+  bool lbfgs_in_kkt = false;
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).
   std::vector<std::string> ipopt_options;
