@@ -11,6 +11,7 @@
 #include <ompl/util/Console.h>
 
 #include "planner/collision/collision_model.h"
+#include "planner/guide/seeded_ompl.h"
 
 namespace acyclic {
 
@@ -45,21 +46,6 @@ struct BodyStates {
     T.linear() = (Eigen::AngleAxisd(v[3], up) * r0.slerp(std::clamp(v[4], 0.0, 1.0), r1)).toRotationMatrix();
     return T;
   }
-};
-
-// OMPL's random generators seeded per call (as the guide author's): the same
-// transition plans the same path whatever ran before it, on any thread.
-class SeededSampler : public ob::RealVectorStateSampler {
- public:
-  SeededSampler(const ob::StateSpace* space, unsigned seed) : ob::RealVectorStateSampler(space) { rng_.setLocalSeed(seed); }
-};
-class SeededRRTConnect : public og::RRTConnect {
- public:
-  SeededRRTConnect(const ob::SpaceInformationPtr& si, unsigned seed) : og::RRTConnect(si) { rng_.setLocalSeed(seed); }
-};
-class SeededSimplifier : public og::PathSimplifier {
- public:
-  SeededSimplifier(const ob::SpaceInformationPtr& si, unsigned seed) : og::PathSimplifier(si) { rng_.setLocalSeed(seed); }
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <functional>
 
 #include "interpolator/body_path.h"
 #include "interpolator/body_path_planner.h"
@@ -525,6 +526,23 @@ Plan chairPlanStances(const Scenario& sc, std::size_t first, std::size_t last) {
   return p;
 }
 
+// The plan (every stance kept) interpolates with one transition repaired and
+// every sample valid; without what `disable` turns off, it is reported
+// unrepairable, naming `stances`.
+void expectRepairedOnlyWith(const Plan& plan, const Scenario& sc, const std::function<void(InterpolatorOptions&)>& disable,
+                            const std::string& stances) {
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+  disable(opt);
+  const InterpolationResult u = interpolate(plan, sc, opt);
+  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
+  EXPECT_NE(u.reason.find(stances), std::string::npos) << u.reason;
+}
+
 }  // namespace
 
 TEST(Interpolator, ThighNearTheHipPivotsOffTheLowSeat) {
@@ -575,17 +593,8 @@ TEST(Interpolator, FootDetoursPastTheChairLegBesideTheOtherFoot) {
   // The right foot leaves the floor in front of the chair's front left leg
   // and is put down beside the chair, between that leg and the left foot:
   // the spline (or any bridge over it) crosses the leg.
-  const Plan plan = chairPlanStances(sc, 61, 63);
-  InterpolatorOptions opt;
-  opt.filter = false;
-  const InterpolationResult r = interpolate(plan, sc, opt);
-  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
-  EXPECT_EQ(r.trajectory.stats.repairs, 1);
-  expectValid(r.trajectory, sc);
-  opt.repair_attempts = 0;
-  const InterpolationResult u = interpolate(plan, sc, opt);
-  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
-  EXPECT_NE(u.reason.find("stances 0 -> 2"), std::string::npos) << u.reason;
+  expectRepairedOnlyWith(chairPlanStances(sc, 61, 63), sc, [](InterpolatorOptions& o) { o.repair_attempts = 0; },
+                         "stances 0 -> 2");
 }
 
 TEST(Interpolator, FootPassesBetweenTheChairLegAndTheOtherFootOnAPlannedPath) {
@@ -599,16 +608,7 @@ TEST(Interpolator, FootPassesBetweenTheChairLegAndTheOtherFootOnAPlannedPath) {
   const Scenario& sc = chairScenario();
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_step.plan.json"), sc);
   ASSERT_EQ(plan.stances.size(), 3u);
-  InterpolatorOptions opt;
-  opt.filter = false;
-  const InterpolationResult r = interpolate(plan, sc, opt);
-  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
-  EXPECT_EQ(r.trajectory.stats.repairs, 1);
-  expectValid(r.trajectory, sc);
-  opt.plan_body_path = false;
-  const InterpolationResult u = interpolate(plan, sc, opt);
-  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
-  EXPECT_NE(u.reason.find("stances 0 -> 2"), std::string::npos) << u.reason;
+  expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.plan_body_path = false; }, "stances 0 -> 2");
 }
 
 TEST(Interpolator, FreeFootKeepsToAPathOfItsOwnWhileTheHandReachesTheTable) {
@@ -621,16 +621,7 @@ TEST(Interpolator, FreeFootKeepsToAPathOfItsOwnWhileTheHandReachesTheTable) {
   const Scenario& sc = chairScenario();
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_reach.plan.json"), sc);
   ASSERT_EQ(plan.stances.size(), 2u);
-  InterpolatorOptions opt;
-  opt.filter = false;
-  const InterpolationResult r = interpolate(plan, sc, opt);
-  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
-  EXPECT_EQ(r.trajectory.stats.repairs, 1);
-  expectValid(r.trajectory, sc);
-  opt.free_limb_paths = false;
-  const InterpolationResult u = interpolate(plan, sc, opt);
-  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
-  EXPECT_NE(u.reason.find("stances 0 -> 1"), std::string::npos) << u.reason;
+  expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.free_limb_paths = false; }, "stances 0 -> 1");
 }
 
 TEST(Interpolator, BadInputAndCancellation) {

@@ -66,6 +66,19 @@ PostureRequest wristOnTable(const Scenario& sc) {
   return r;
 }
 
+// Central differences of the problem's cost at x, variable by variable.
+Eigen::VectorXd numericCostGradient(PostureProblem& p, const Eigen::VectorXd& x) {
+  Eigen::VectorXd g(x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    const double h = 1e-6;
+    Eigen::VectorXd a = x, b = x;
+    a[i] += h;
+    b[i] -= h;
+    g[i] = (p.cost(a) - p.cost(b)) / (2 * h);
+  }
+  return g;
+}
+
 }  // namespace
 
 TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
@@ -80,16 +93,14 @@ TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
     const Eigen::MatrixXd J = p.constraintJacobian(x);
     const Eigen::VectorXd gf = p.costGradient(x);
     Eigen::MatrixXd Jn(J.rows(), J.cols());
-    Eigen::VectorXd gn(x.size());
     for (int i = 0; i < x.size(); ++i) {
       const double h = 1e-6;
       Eigen::VectorXd a = x, b = x;
       a[i] += h;
       b[i] -= h;
       Jn.col(i) = (p.constraints(a) - p.constraints(b)) / (2 * h);
-      gn[i] = (p.cost(a) - p.cost(b)) / (2 * h);
     }
-    EXPECT_LT(test::relativeError(gf, gn), 1e-6);
+    EXPECT_LT(test::relativeError(gf, numericCostGradient(p, x)), 1e-6);
     auto block = [&](int r0, int r1) {
       return test::relativeError(J.middleRows(r0, r1 - r0), Jn.middleRows(r0, r1 - r0));
     };
@@ -137,15 +148,7 @@ TEST(PostureProblem, SpotTargetsOfTheReferenceCostMatchFiniteDifferences) {
   Eigen::VectorXd x = p.initialPoint();
   for (int i = 0; i < sc.robot->tangentSize(); ++i) x[i] += n(rng);
   const Eigen::VectorXd g = p.costGradient(x);
-  Eigen::VectorXd gn(x.size());
-  for (int i = 0; i < x.size(); ++i) {
-    const double h = 1e-6;
-    Eigen::VectorXd a = x, b = x;
-    a[i] += h;
-    b[i] -= h;
-    gn[i] = (p.cost(a) - p.cost(b)) / (2 * h);
-  }
-  EXPECT_LT(test::relativeError(g, gn), 1e-6);
+  EXPECT_LT(test::relativeError(g, numericCostGradient(p, x)), 1e-6);
   // The targets count: without them the cost and its gradient differ.
   PostureRequest plain = r;
   plain.cost = std::make_shared<ReferencePostureCost>(sc.start);

@@ -13,6 +13,7 @@
 #include "planner/check/validity.h"
 #include "planner/collision/collision_model.h"
 #include "planner/common/geometry.h"
+#include "planner/guide/seeded_ompl.h"
 #include "planner/posture/posture_generator.h"
 
 namespace ob = ompl::base;
@@ -83,25 +84,6 @@ class RelaxedValidity : public ob::StateValidityChecker {
   mutable Kinematics kin_;
   CollisionModel collision_;
   double penetration_;
-};
-
-// OMPL's random generators, seeded per call: the same scenario and seed give
-// the same guide in any process, however many guides it made before.
-class SeededSampler : public ob::RealVectorStateSampler {
- public:
-  SeededSampler(const ob::StateSpace* space, unsigned seed) : ob::RealVectorStateSampler(space) {
-    rng_.setLocalSeed(seed);
-  }
-};
-class SeededRRTConnect : public og::RRTConnect {
- public:
-  SeededRRTConnect(const ob::SpaceInformationPtr& si, unsigned seed) : og::RRTConnect(si) { rng_.setLocalSeed(seed); }
-};
-class SeededSimplifier : public og::PathSimplifier {
- public:
-  SeededSimplifier(const ob::SpaceInformationPtr& si, unsigned seed) : og::PathSimplifier(si) {
-    rng_.setLocalSeed(seed);
-  }
 };
 
 // Each contact placed where kin holds its spot, supporting; false if one
