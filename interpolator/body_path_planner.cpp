@@ -106,7 +106,8 @@ BodyPathPlan planBodyPath(const BodyPath& path, const RobotModel& robot, const S
     const Eigen::Isometry3d T = states.pose(v);
     return linkClearance(T, robot, scene, spot, held) >= required(T.translation());
   });
-  // A check every 0.5% of the space's extent along a motion: under 5 mm here.
+  // A check every 0.5% of the space's largest extent along a motion (under a
+  // centimetre of its distance, metres and radians alike, for a foot's step).
   si->setStateValidityCheckingResolution(0.005);
   ob::ScopedState<ob::RealVectorStateSpace> start(space), goal(space);
   for (int k = 0; k < 3; ++k) start[k] = a.translation()[k], goal[k] = b.translation()[k];
