@@ -420,15 +420,14 @@ std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& pl
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   const RobotModel& m = *sc_.robot;
-  auto limbOf = [&](int spot) { return m.limbRootJoint(m.spots()[spot].link); };
   auto depth = [&](int spot) { return m.ancestorJoints(m.spots()[spot].link).size(); };
   std::vector<int> ends;  // per free limb, its most distal spot
   for (int i = 0; i < static_cast<int>(m.spots().size()); ++i) {
-    const int root = limbOf(i);
-    bool held = root < 0 || root == limbOf(d.spot);
-    for (const auto& c : d.motion_contacts) held = held || limbOf(c.spot) == root;
+    const int root = m.spotLimbRootJoint(i);
+    bool held = root < 0 || root == m.spotLimbRootJoint(d.spot);
+    for (const auto& c : d.motion_contacts) held = held || m.spotLimbRootJoint(c.spot) == root;
     if (held) continue;
-    const auto same = std::find_if(ends.begin(), ends.end(), [&](int e) { return limbOf(e) == root; });
+    const auto same = std::find_if(ends.begin(), ends.end(), [&](int e) { return m.spotLimbRootJoint(e) == root; });
     if (same == ends.end())
       ends.push_back(i);
     else if (depth(i) > depth(*same))

@@ -87,6 +87,7 @@ class RobotModel {
   // whose parent link branches (a leg's hip yaw, an arm's shoulder); -1 for
   // the trunk's links above every branch.
   int limbRootJoint(int link) const { return limb_root_[link]; }
+  int spotLimbRootJoint(int spot) const { return limb_root_[spots_[spot].link]; }
 
   int jointIndex(const std::string& name) const;  // -1 if unknown
   int linkIndex(const std::string& name) const;

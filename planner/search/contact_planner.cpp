@@ -119,12 +119,8 @@ struct ContactPlanner::Impl {
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
 
-  // Per spot, the joint its limb hangs from (RobotModel::limbRootJoint).
-  std::vector<int> limb;
-
   Impl(const Scenario& s, PlannerParameters params)
       : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), rng(s.seed) {
-    for (const auto& spot : s.robot->spots()) limb.push_back(s.robot->limbRootJoint(spot.link));
     for (int t = 0; t < std::max(1, p.threads); ++t)
       pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
     if (p.guide_potential) {
@@ -199,12 +195,8 @@ struct ContactPlanner::Impl {
     const RobotModel& m = *sc.robot;
     const ContactSpot& s = m.spots()[spot];
     const std::vector<int>& chain = m.ancestorJoints(s.link);
-    // the limb's root: the first joint below the trunk (waist, chest)
-    int root = -1;
-    for (int j : chain) {
-      const std::string& parent = m.links()[m.joints()[j].parent_link].name;
-      if (parent == "WAIST" || parent.rfind("CHEST", 0) == 0) root = j;
-    }
+    // the limb's root: the first joint below the trunk (a hip, a shoulder)
+    const int root = m.limbRootJoint(s.link);
     if (root < 0) return true;
     // the limb's length: the rigid offsets from joint to joint below the root, then to the spot
     double reach = s.frame.translation().norm();
@@ -451,7 +443,9 @@ struct ContactPlanner::Impl {
     if (!p.failure_memory || !p.optimized_candidates) return false;
     const int pi = nodes[ni].parent;
     if (pi < 0) return false;
-    if (nodes[ni].changed_spot >= 0 && limb[nodes[ni].changed_spot] == limb[spot]) return false;
+    const RobotModel& m = *sc.robot;
+    if (nodes[ni].changed_spot >= 0 && m.spotLimbRootJoint(nodes[ni].changed_spot) == m.spotLimbRootJoint(spot))
+      return false;
     const auto& failed = nodes[pi].failed_pairs;
     auto it = std::find_if(failed.begin(), failed.end(),
                            [&](const FailedPair& f) { return f.spot == spot && f.surface == surface; });
