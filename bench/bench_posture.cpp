@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--max-seconds")) opt.max_seconds = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--max-iterations")) opt.max_iterations = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--hessian")) opt.hessian = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--linear-solver")) opt.linear_solver = argv[i + 1];
     else if (!std::strcmp(argv[i], "--cutoff")) opt.problem.collision_cutoff = std::atof(argv[i + 1]);
   }
   const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml");

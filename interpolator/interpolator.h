@@ -39,9 +39,10 @@ struct InterpolatorOptions {
   int posture_iterations = 100;
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out
   std::vector<std::string> posture_ipopt_options;  // "name=value", passed to each posture solve
-  // The faster KKT solve (PostureGeneratorOptions::lbfgs_in_kkt): knots drive
-  // no search, so the witnesses it changes change nothing downstream.
-  bool posture_lbfgs_in_kkt = true;
+  // L-BFGS's low-rank part inside the KKT system
+  // (PostureGeneratorOptions::lbfgs_in_kkt), which needs the "mumps" solver.
+  // Off: Sherman-Morrison's extra solves cost little with "ldl".
+  bool posture_lbfgs_in_kkt = false;
   // Transitions solved at once, one solver each (same result for any count).
   int threads = 2;
 };

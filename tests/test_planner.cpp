@@ -159,7 +159,9 @@ TEST(ContactPlanner, TheFailureMemorySkipsPairsThatJustFailedFromTheSamePlace) {
   // The chair, 25 nodes: sons of the seated robot keep most spots where
   // their parents held them, and a pair that failed there (a knee on the
   // table) is not tried again. Without the memory every pair is tried at
-  // every node: more posture calls for the same number of nodes.
+  // every node: more failed posture calls for the same number of nodes (not
+  // always more calls: the calls saved go to other pairs, some of which
+  // succeed; 33 failures of 63 calls against 35 of 59 with the LDL^T solver).
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));
   PlannerParameters with = plannerParameters(sc), without = with;
   with.max_nodes = without.max_nodes = 25;
@@ -170,7 +172,7 @@ TEST(ContactPlanner, TheFailureMemorySkipsPairsThatJustFailedFromTheSamePlace) {
   EXPECT_EQ(b.status, PlanningResult::Status::NodeBudget) << b.reason;
   EXPECT_GT(a.stats.pairs_remembered, 0);
   EXPECT_EQ(b.stats.pairs_remembered, 0);
-  EXPECT_LT(a.stats.posture_calls, b.stats.posture_calls);
+  EXPECT_LT(a.stats.posture_failures, b.stats.posture_failures);
   // The memory is part of the search: still deterministic.
   const PlanningResult c = ContactPlanner(sc, with).plan();
   EXPECT_EQ(c.stats.posture_calls, a.stats.posture_calls);

@@ -356,11 +356,12 @@ TEST(PostureGenerator, ChairStartFromPerturbedGuess) {  // (a)
   }
 }
 
-TEST(PostureGenerator, LowRankInTheKktSystemSolvesTheSameStance) {
-  // lbfgs_in_kkt changes how Ipopt solves its linear systems, not the
-  // problem: the chair's start stance from the same perturbed guess is
-  // solved either way, to the same posture within the solver's tolerances,
-  // and the independent check accepts both.
+TEST(PostureGenerator, EveryLinearSolverSolvesTheSameStance) {
+  // The linear solver (kkt_ldl.h's LDL^T or MUMPS) and where L-BFGS's
+  // low-rank part goes (lbfgs_in_kkt, MUMPS only) change how Ipopt solves its
+  // linear systems, not the problem: the chair's start stance from the same
+  // perturbed guess is solved each way, to the same posture within the
+  // solver's tolerances, and the independent check accepts each.
   const Scenario& sc = chair();
   PostureRequest r;
   r.contacts = sc.start_stance;
@@ -369,15 +370,31 @@ TEST(PostureGenerator, LowRankInTheKktSystemSolvesTheSameStance) {
   r.initial_guess.joints.array() += 0.05;
   r.cost = std::make_shared<ReferencePostureCost>(sc.start);
   PostureGeneratorOptions o;
-  const PostureResult a = PostureGenerator(sc.robot, sc.scene, o).solve(r);
+  ASSERT_EQ(o.linear_solver, "ldl");  // the default
+  const PostureResult ldl = PostureGenerator(sc.robot, sc.scene, o).solve(r);
+  o.linear_solver = "mumps";
+  const PostureResult mumps = PostureGenerator(sc.robot, sc.scene, o).solve(r);
   o.lbfgs_in_kkt = true;
-  const PostureResult b = PostureGenerator(sc.robot, sc.scene, o).solve(r);
-  ASSERT_TRUE(a.success()) << a.reason;
-  ASSERT_TRUE(b.success()) << b.reason;
-  EXPECT_LT(difference(a.configuration, b.configuration).cwiseAbs().maxCoeff(), 0.02);
+  const PostureResult lowRank = PostureGenerator(sc.robot, sc.scene, o).solve(r);
   ValidityChecker checker(sc.robot, sc.scene);
-  EXPECT_TRUE(checker.checkPosture(a.configuration, r.contacts).valid());
-  EXPECT_TRUE(checker.checkPosture(b.configuration, r.contacts).valid());
+  for (const PostureResult* res : {&ldl, &mumps, &lowRank}) {
+    ASSERT_TRUE(res->success()) << res->reason;
+    EXPECT_LT(difference(ldl.configuration, res->configuration).cwiseAbs().maxCoeff(), 0.02);
+    EXPECT_TRUE(checker.checkPosture(res->configuration, r.contacts).valid());
+  }
+}
+
+TEST(PostureGenerator, LdlRefusesAFullHessianBlock) {
+  // The LDL^T needs a diagonal Hessian block; a full one is misuse, said at
+  // construction rather than as a failed solve.
+  const Scenario& sc = chair();
+  PostureGeneratorOptions o;
+  o.hessian = "analytic";
+  EXPECT_THROW(PostureGenerator(sc.robot, sc.scene, o), std::invalid_argument);
+  o.linear_solver = "mumps";
+  EXPECT_NO_THROW(PostureGenerator(sc.robot, sc.scene, o));
+  o.linear_solver = "pardiso";
+  EXPECT_THROW(PostureGenerator(sc.robot, sc.scene, o), std::invalid_argument);
 }
 
 TEST(PostureGenerator, HalfSittingDoubleSupport) {  // (b)
@@ -577,17 +594,19 @@ TEST(PostureGenerator, TwoGeneratorsOnTwoThreadsAgreeWithOne) {
   }
 }
 
-// libacyclic_mumps_lock.so must be the definition the process uses for both
-// MUMPS entry points it replaces: dmumps_c (the lock) and the per-call
-// memory-save estimate (a fifth of a solve's CPU, planner/posture/mumps_lock.cpp).
-// A link order that puts libdmumps_seq first would silently lose both.
+// libacyclic_ipopt_interposers.so must be the definition the process uses
+// for the MUMPS entry points it replaces: dmumps_c (the lock) and the
+// per-call memory-save estimate (a fifth of a solve's CPU,
+// planner/posture/mumps_lock.cpp), and for Ipopt's clock (ipopt_clock.cpp).
+// A link order that puts libdmumps_seq or libipopt first would silently lose them.
 TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
-  for (const char* name : {"dmumps_c", "__dmumps_save_restore_MOD_dmumps_compute_memory_save"}) {
+  for (const char* name : {"dmumps_c", "__dmumps_save_restore_MOD_dmumps_compute_memory_save", "_ZN5Ipopt7CpuTimeEv",
+                           "_ZN5Ipopt7SysTimeEv"}) {
     void* sym = dlsym(RTLD_DEFAULT, name);
     ASSERT_NE(sym, nullptr) << name;
     Dl_info info{};
     ASSERT_NE(dladdr(sym, &info), 0) << name;
-    EXPECT_NE(std::string(info.dli_fname).find("acyclic_mumps_lock"), std::string::npos)
+    EXPECT_NE(std::string(info.dli_fname).find("acyclic_ipopt_interposers"), std::string::npos)
         << name << " resolves to " << info.dli_fname;
   }
   // And MUMPS still solves through them: the chair's start stance from a perturbed guess.
@@ -596,7 +615,9 @@ TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
   PostureRequest r;
   r.contacts = sc.start_stance;
   r.initial_guess = perturbed(sc.start, rng, 0.05, 0.02);
-  PostureGenerator pg(sc.robot, sc.scene);
+  PostureGeneratorOptions o;
+  o.linear_solver = "mumps";
+  PostureGenerator pg(sc.robot, sc.scene, o);
   EXPECT_TRUE(pg.solve(r).success());
 }
 

@@ -1,4 +1,5 @@
 #include "planner/posture/posture_generator.h"
+#include "planner/posture/kkt_ldl.h"
 
 #include <chrono>
 #include <cstdlib>
@@ -138,7 +139,7 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
     : robot_(std::move(robot)), scene_(std::move(scene)),
       collision_(std::make_shared<CollisionModel>(robot_, scene_)), opt_(options),
       ipopt_(std::make_unique<Ipopt>()) {
-  (void)acyclic_mumps_lock_linked();  // keeps the lock library in every link
+  (void)acyclic_mumps_lock_linked();  // keeps the interposers' library in every link
   auto& app = ipopt_->app;
   app = IpoptApplicationFactory();
   auto o = app->Options();
@@ -149,6 +150,21 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
     throw std::invalid_argument("PostureGeneratorOptions::hessian: expected lbfgs, analytic or diagonal");
   o->SetStringValue("hessian_approximation", opt_.hessian == "lbfgs" ? "limited-memory" : "exact");
   if (opt_.hessian == "lbfgs" && opt_.lbfgs_in_kkt) o->SetStringValue("limited_memory_aug_solver", "extended");
+  if (opt_.linear_solver == "ldl") {
+    if (opt_.hessian == "analytic" || (opt_.hessian == "lbfgs" && opt_.lbfgs_in_kkt))
+      throw std::invalid_argument(
+          "PostureGeneratorOptions::linear_solver \"ldl\" needs a diagonal Hessian block (hessian lbfgs without "
+          "lbfgs_in_kkt, or diagonal); use \"mumps\" with the others");
+    kkt::registerWithIpopt();
+    o->SetStringValue("linear_solver", "ma27");  // the loader's name for what registerWithIpopt supplies
+    o->SetStringValue("linear_system_scaling", "none");
+    o->SetNumericValue("ma27_la_init_factor", 1.0);   // its workspace estimates are exact
+    o->SetNumericValue("ma27_liw_init_factor", 1.0);
+    o->SetNumericValue("ma27_pivtolmax", 1e-8);       // no pivoting: nothing to raise
+    o->SetNumericValue("ma27_pivtol", 1e-8);
+  } else if (opt_.linear_solver != "mumps") {
+    throw std::invalid_argument("PostureGeneratorOptions::linear_solver: expected ldl or mumps");
+  }
   o->SetStringValue("mu_strategy", "adaptive");
   o->SetNumericValue("tol", opt_.tolerance);
   o->SetNumericValue("constr_viol_tol", opt_.tolerance);

@@ -31,6 +31,12 @@ struct PostureGeneratorOptions {
   // the chair's search, chaotic in them, then did not solve in 3,000 nodes
   // (README "Posture generator"); the interpolator turns it on.
   bool lbfgs_in_kkt = false;
+  // Ipopt's linear solver: "ldl" (kkt_ldl.h: a sparse LDL^T in an order
+  // these KKT systems need no pivoting in, reentrant, so that two generators
+  // on two threads run in parallel) or "mumps" (Debian's Ipopt's own,
+  // serialized by a process-wide lock). "ldl" needs a diagonal Hessian block:
+  // hessian "lbfgs" without lbfgs_in_kkt, or "diagonal".
+  std::string linear_solver = "ldl";
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).
   std::vector<std::string> ipopt_options;

@@ -1,0 +1,105 @@
+// kkt_ldl.h's factorization behind HSL MA27's calling sequence, which
+// Ipopt 3.11's linear-solver loader takes from whoever supplies it
+// (LSL_setMA27) instead of a libhsl.so. Ipopt's Ma27TSolverInterface then
+// drives it: MA27AD once per problem structure, MA27BD per matrix, MA27CD
+// per right-hand side. Everything it needs between the calls is in the arrays
+// Ipopt owns per solver instance:
+//   IKEEP[3N] = perm | elimination tree | column counts   (from MA27AD)
+//   IW        = perm | Lp[N+1] | Li                        (from MA27BD)
+//   A         = D[N] | Lx   (on entry to MA27BD: the matrix's values)
+// MA27's pivot tolerance (CNTL(1)) has no meaning here: there is no pivoting.
+#include <algorithm>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "planner/posture/kkt_ldl.h"
+
+extern "C" {
+typedef void (*ma27ad_t)(int* N, int* NZ, const int* IRN, const int* ICN, int* IW, int* LIW, int* IKEEP, int* IW1,
+                         int* NSTEPS, int* IFLAG, int* ICNTL, double* CNTL, int* INFO, double* OPS);
+typedef void (*ma27bd_t)(int* N, int* NZ, const int* IRN, const int* ICN, double* A, int* LA, int* IW, int* LIW,
+                         int* IKEEP, int* NSTEPS, int* MAXFRT, int* IW1, int* ICNTL, double* CNTL, int* INFO);
+typedef void (*ma27cd_t)(int* N, double* A, int* LA, int* IW, int* LIW, double* W, int* MAXFRT, double* RHS, int* IW1,
+                         int* NSTEPS, int* ICNTL, double* CNTL);
+typedef void (*ma27id_t)(int* ICNTL, double* CNTL);
+// Ipopt's HSL loader (libipopt.so.1, Ipopt 3.11).
+void LSL_setMA27(ma27ad_t, ma27bd_t, ma27cd_t, ma27id_t);
+}
+
+namespace acyclic::kkt {
+
+namespace {
+
+// MA27's INFO(1) codes that Ipopt's interface acts on.
+constexpr int kOk = 0, kFatal = -1, kIwTooSmall = -3, kATooSmall = -4, kSingular = 3;
+
+long entriesOfL(int n, const int* colcount) {
+  long total = 0;
+  for (int i = 0; i < n; ++i) total += colcount[i];
+  return total;
+}
+
+void initialize(int* icntl, double* cntl) {
+  std::fill(icntl, icntl + 30, 0);
+  std::fill(cntl, cntl + 5, 0.0);
+}
+
+void analyseEntry(int* N, int* NZ, const int* IRN, const int* ICN, int*, int*, int* IKEEP, int*, int* NSTEPS,
+                  int*, int*, double*, int* INFO, double* OPS) {
+  std::fill(INFO, INFO + 20, 0);
+  const int n = *N;
+  const long lnz = analyse(n, *NZ, IRN, ICN, IKEEP, IKEEP + n, IKEEP + 2 * n, nullptr);
+  *NSTEPS = 1;
+  *OPS = 0;
+  if (lnz < 0) {
+    INFO[0] = kFatal;
+    return;
+  }
+  INFO[4] = static_cast<int>(std::max<long>(*NZ, n + lnz));  // reals needed
+  INFO[5] = static_cast<int>(2 * n + 1 + lnz);               // integers needed
+}
+
+void factorEntry(int* N, int* NZ, const int* IRN, const int* ICN, double* A, int* LA, int* IW, int* LIW, int* IKEEP,
+                 int*, int* MAXFRT, int*, int*, double*, int* INFO) {
+  std::fill(INFO, INFO + 20, 0);
+  const int n = *N, nz = *NZ;
+  const int* perm = IKEEP;
+  const long lnz = entriesOfL(n, IKEEP + 2 * n);
+  const long reals = std::max<long>(nz, n + lnz), ints = 2 * n + 1 + lnz;
+  if (*LIW < ints) {
+    INFO[0] = kIwTooSmall;
+    INFO[1] = static_cast<int>(ints);
+    return;
+  }
+  if (*LA < reals) {
+    INFO[0] = kATooSmall;
+    INFO[1] = static_cast<int>(reals);
+    return;
+  }
+  thread_local std::vector<double> values;
+  values.assign(A, A + nz);  // the factors overwrite them
+  std::copy(perm, perm + n, IW);
+  int* Lp = IW + n;
+  int negative = 0;
+  const int zero = factor(n, nz, IRN, ICN, values.data(), perm, IKEEP + n, IKEEP + 2 * n, Lp, Lp + n + 1, A + n, A,
+                          &negative);
+  *MAXFRT = n;  // the length of W in MA27CD: our scratch vector
+  INFO[0] = zero ? kSingular : kOk;
+  INFO[14] = negative;
+}
+
+void solveEntry(int* N, double* A, int*, int* IW, int*, double* W, int*, double* RHS, int*, int*, int*, double*) {
+  const int n = *N;
+  const int* Lp = IW + n;
+  solve(n, IW, Lp, Lp + n + 1, A + n, A, RHS, W);
+}
+
+}  // namespace
+
+void registerWithIpopt() {
+  static std::once_flag once;
+  std::call_once(once, [] { LSL_setMA27(analyseEntry, factorEntry, solveEntry, initialize); });
+}
+
+}  // namespace acyclic::kkt
