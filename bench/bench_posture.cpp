@@ -3,7 +3,7 @@
 // infeasible): success rate, time per call for successes and for failures,
 // iterations, and how many successes the independent check accepts.
 // Usage: bench_posture [--problems N] [--seed S] [--max-seconds T] [--max-iterations N]
-//                      [--cutoff M] [--ipopt name=value]...
+//                      [--cutoff M] [--hessian H] [--linear-solver ldl|mumps] [--ipopt name=value]...
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

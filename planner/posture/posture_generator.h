@@ -29,7 +29,8 @@ struct PostureGeneratorOptions {
   // amortize. bench_posture: successes 1.2-1.8 times faster at the same
   // iterations, failures 1.5-1.8. Off by default: the witnesses differ, and
   // the chair's search, chaotic in them, then did not solve in 3,000 nodes
-  // (README "Posture generator"); the interpolator turns it on.
+  // (README "Posture generator"). Needs linear_solver "mumps": with "ldl"
+  // Sherman-Morrison's solves cost little (bench_posture: "ldl" is faster).
   bool lbfgs_in_kkt = false;
   // Ipopt's linear solver: "ldl" (kkt_ldl.h: a sparse LDL^T in an order
   // these KKT systems need no pivoting in, reentrant, so that two generators

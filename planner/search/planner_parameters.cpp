@@ -7,7 +7,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   if (!sc.planner_section) return p;
   const YamlField& f = *sc.planner_section;
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
-               "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations",
+               "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -41,6 +41,11 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   count("max_posture_calls", p.max_posture_calls);
   count("posture_iterations", p.posture.max_iterations);
   count("threads", p.threads);
+  if (f.has("posture_linear_solver")) {
+    const std::string v = f["posture_linear_solver"].string();
+    if (v != "ldl" && v != "mumps") f["posture_linear_solver"].fail("ldl or mumps");
+    p.posture.linear_solver = v;
+  }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
     if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
