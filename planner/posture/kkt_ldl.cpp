@@ -12,8 +12,10 @@ constexpr double kZeroPivot = 1e-13;
 
 // Scratch reused across calls on one thread (never state between calls).
 struct Scratch {
-  std::vector<int> a, b, c, d, e;
-  std::vector<double> x;
+  std::vector<int> pinv, colptr, rows, src;  // the permuted upper triangle (permutedUpper)
+  std::vector<int> next;                     // permutedUpper's fill positions
+  std::vector<int> work;                     // factor's flag, filled and pattern
+  std::vector<double> y;                     // factor's row being eliminated
 };
 Scratch& scratch() {
   thread_local Scratch s;
@@ -32,7 +34,7 @@ void permutedUpper(int n, int nz, const int* irn, const int* jcn, const int* pin
   for (int j = 0; j < n; ++j) colptr[j + 1] += colptr[j];
   rows.resize(nz);
   src.resize(nz);
-  std::vector<int>& next = scratch().e;
+  std::vector<int>& next = scratch().next;
   next.assign(colptr.begin(), colptr.end() - 1);
   for (int k = 0; k < nz; ++k) {
     const int i = pinv[irn[k] - 1], j = pinv[jcn[k] - 1];
@@ -131,22 +133,22 @@ long analyse(int n, int nz, const int* irn, const int* jcn, int* perm, int* pare
 int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const int* perm, const int* parent,
            const int* colcount, int* Lp, int* Li, double* Lx, double* D, int* negative) {
   Scratch& s = scratch();
-  std::vector<int>& pinv = s.a;
+  std::vector<int>& pinv = s.pinv;
   pinv.resize(n);
   for (int i = 0; i < n; ++i) pinv[perm[i]] = i;
-  std::vector<int>& colptr = s.b;
-  std::vector<int>& rows = s.c;
-  std::vector<int>& src = s.d;
+  std::vector<int>& colptr = s.colptr;
+  std::vector<int>& rows = s.rows;
+  std::vector<int>& src = s.src;
   permutedUpper(n, nz, irn, jcn, pinv.data(), colptr, rows, src);
 
   Lp[0] = 0;
   for (int c = 0; c < n; ++c) Lp[c + 1] = Lp[c] + colcount[c];
-  std::vector<int>& work = s.e;  // flag[n], filled[n], pattern[n]
+  std::vector<int>& work = s.work;  // flag[n], filled[n], pattern[n]
   work.assign(3 * static_cast<std::size_t>(n), 0);
   int* flag = work.data();
   int* filled = flag + n;
   int* pattern = filled + n;
-  std::vector<double>& y = s.x;
+  std::vector<double>& y = s.y;
   y.assign(n, 0.0);
   *negative = 0;
   for (int k = 0; k < n; ++k) {
