@@ -4,6 +4,7 @@
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 #include <regex>
 #include <set>
@@ -621,19 +622,44 @@ TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
   EXPECT_TRUE(pg.solve(r).success());
 }
 
-// The independent check restarts each LP from the previous call's basis. Along
-// every stance of the chair plan, walked in small steps toward the next
-// witness (as the trajectory check walks samples), and with supports that
-// cannot hold the robot mixed in, one checker kept warm must give the same
-// verdicts, margins and torque ratios as a fresh checker for each call.
+// Postures along every third stance of the chair plan, walked in small steps
+// toward the next witness (as the trajectory check walks samples), and with
+// supports that cannot hold the robot mixed in (only the stance's first
+// supporting contact kept), each passed to `check` in that order.
+namespace {
+void forEachChairPlanCheck(const Scenario& sc,
+                           const std::function<void(const Configuration&, const std::vector<ContactSpec>&)>& check) {
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
+  for (std::size_t i = 0; i + 1 < plan.stances.size(); i += 3) {
+    const auto stance = plan.stances[i].specs();
+    const Configuration& q0 = plan.stances[i].configuration;
+    const Configuration& q1 = plan.stances[i + 1].configuration;
+    for (double t : {0.0, 0.02, 0.04}) {
+      Configuration q = q0;
+      q.base_position = (1 - t) * q0.base_position + t * q1.base_position;
+      q.joints = (1 - t) * q0.joints + t * q1.joints;
+      check(q, stance);
+    }
+    auto one = stance;
+    bool first = true;
+    for (auto& c : one)
+      if (c.supporting) c.supporting = first, first = false;
+    check(q0, one);
+    check(q0, stance);
+  }
+}
+}  // namespace
+
+// The independent check restarts each LP from the previous call's basis: one
+// checker kept warm must give the same verdicts, margins and torque ratios as
+// a fresh checker for each call.
 TEST(QuasiStaticCheck, WarmStartedChecksAgreeWithColdOnes) {
   const Scenario& sc = chair();
-  const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
   QuasiStaticChecker warm(sc.robot, sc.scene);
   warm.setWarmStart(true);
   Kinematics k(sc.robot);
   int checks = 0, infeasible = 0;
-  auto compare = [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
+  forEachChairPlanCheck(sc, [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
     k.setConfiguration(q);
     const QuasiStaticReport a = warm.check(k, stance);
     const QuasiStaticReport b = QuasiStaticChecker(sc.robot, sc.scene).check(k, stance);
@@ -646,25 +672,33 @@ TEST(QuasiStaticCheck, WarmStartedChecksAgreeWithColdOnes) {
     if (b.feasible) {
       EXPECT_NEAR(a.worst_torque_ratio, b.worst_torque_ratio, 1e-5) << checks;  // Clp's tolerances
     }
-  };
-  for (std::size_t i = 0; i + 1 < plan.stances.size(); i += 3) {
-    const auto stance = plan.stances[i].specs();
-    const Configuration& q0 = plan.stances[i].configuration;
-    const Configuration& q1 = plan.stances[i + 1].configuration;
-    for (double t : {0.0, 0.02, 0.04}) {
-      Configuration q = q0;
-      q.base_position = (1 - t) * q0.base_position + t * q1.base_position;
-      q.joints = (1 - t) * q0.joints + t * q1.joints;
-      compare(q, stance);
-    }
-    // Only the first supporting contact of the stance holds the robot.
-    auto one = stance;
-    bool first = true;
-    for (auto& c : one)
-      if (c.supporting) c.supporting = first, first = false;
-    compare(q0, one);
-    compare(q0, stance);
-  }
+  });
   EXPECT_GT(checks, 100);
   EXPECT_GT(infeasible, 5);  // the single supports
+}
+
+// Without the margin's LP (setMarginComputed(false), as the trajectory
+// verifications run) the verdict, its reason and the torque ratio are those of
+// the full check, feasible or not, and the margin is reported as not computed.
+TEST(QuasiStaticCheck, VerdictsWithoutTheMarginLpAgreeWithFullChecks) {
+  const Scenario& sc = chair();
+  QuasiStaticChecker verdicts(sc.robot, sc.scene), full(sc.robot, sc.scene);
+  verdicts.setMarginComputed(false);
+  Kinematics k(sc.robot);
+  int checks = 0, infeasible = 0, torque_bound = 0;
+  forEachChairPlanCheck(sc, [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
+    k.setConfiguration(q);
+    const QuasiStaticReport a = verdicts.check(k, stance);
+    const QuasiStaticReport b = full.check(k, stance);
+    ++checks;
+    infeasible += !b.feasible;
+    torque_bound += b.worst_torque_ratio > 0.5;
+    ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
+    EXPECT_EQ(a.reason, b.reason) << checks;
+    EXPECT_TRUE(std::isnan(a.margin)) << checks;
+    EXPECT_DOUBLE_EQ(a.worst_torque_ratio, b.worst_torque_ratio) << checks;  // the same LP 2, both cold
+  });
+  EXPECT_GT(checks, 100);
+  EXPECT_GT(infeasible, 5);
+  EXPECT_GT(torque_bound, 0);
 }

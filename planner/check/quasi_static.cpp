@@ -69,6 +69,7 @@ QuasiStaticChecker::QuasiStaticChecker(std::shared_ptr<const RobotModel> robot, 
 
 QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const {
   QuasiStaticReport rep;
+  if (!margin_computed_) rep.margin = std::numeric_limits<double>::quiet_NaN();
   const RobotModel& m = *robot_;
   const int nt = m.tangentSize();
   const double W = m.totalMass() * 9.81;
@@ -167,10 +168,12 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
   }
   rep.worst_torque_ratio = x2[t_col];
   // LP 1: how far inside the pyramids the forces can stay, torques within limits.
-  Lp lp1;
-  const int s_col = build(lp1, true);
-  std::vector<double> x1;
-  rep.margin = lp1.solve(x1, warm1) ? x1[s_col] : -std::numeric_limits<double>::infinity();
+  if (margin_computed_) {
+    Lp lp1;
+    const int s_col = build(lp1, true);
+    std::vector<double> x1;
+    rep.margin = lp1.solve(x1, warm1) ? x1[s_col] : -std::numeric_limits<double>::infinity();
+  }
 
   // Forces, torques and the balance residual at LP 2's solution.
   Eigen::VectorXd JTf = Eigen::VectorXd::Zero(nt);
@@ -190,11 +193,12 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     const double r = std::abs(tau[6 + j.index]) / j.effort;
     if (r > worst) worst = r, rep.worst_joint = j.name;
   }
-  rep.feasible = worst <= 1 + 1e-9 && rep.margin >= -1e-9 && rep.residual <= residualTolerance();
+  const bool margin_ok = !margin_computed_ || rep.margin >= -1e-9;  // implied by worst <= 1 (setMarginComputed)
+  rep.feasible = worst <= 1 + 1e-9 && margin_ok && rep.residual <= residualTolerance();
   if (!rep.feasible) {
     std::ostringstream os;
     if (worst > 1 + 1e-9) os << "the least torque needs " << worst << " times the limit at " << rep.worst_joint;
-    else if (rep.margin < -1e-9) os << "no forces within both the friction pyramids and the torque limits";
+    else if (!margin_ok) os << "no forces within both the friction pyramids and the torque limits";
     else os << "balance residual " << rep.residual << " of the weight";
     rep.reason = os.str();
   }

@@ -25,7 +25,7 @@ namespace acyclic {
 struct QuasiStaticReport {
   bool feasible = false;
   std::string reason;               // why not, when infeasible
-  double margin = 0;                // N: LP 1's s (negative: friction must be exceeded)
+  double margin = 0;                // N: LP 1's s (negative: friction must be exceeded); NaN: not computed
   double worst_torque_ratio = 0;    // LP 2's optimum (<= 1 when feasible)
   std::string worst_joint;
   double residual = 0;              // |force and moment balance| / weight, at LP 2's forces
@@ -51,6 +51,13 @@ class QuasiStaticChecker {
   // may, where they are not unique (callers that use the forces, such as the
   // bridge's ZMP reference, leave it off).
   void setWarmStart(bool on) { warm_start_ = on; }
+  // On by default. Off, LP 1 is not solved and the report's margin is NaN:
+  // the verdict is the same, because LP 2's forces with s = 0 are feasible
+  // for LP 1 whenever LP 2's torque ratio is at most 1 (they are inside the
+  // pyramids, balance exactly, and keep every torque within its limit), and
+  // the check refuses a ratio above 1 anyway. For callers that need only the
+  // verdict, thousands of times (a trajectory's samples): half the LPs.
+  void setMarginComputed(bool on) { margin_computed_ = on; }
 
   struct WarmStart {
     int rows = -1, cols = -1;
@@ -62,6 +69,7 @@ class QuasiStaticChecker {
   std::shared_ptr<const Scene> scene_;
   // Guarded: a checker shared by threads solves cold when another holds it.
   bool warm_start_ = false;
+  bool margin_computed_ = true;
   mutable std::mutex warm_mutex_;
   mutable WarmStart warm_[2];
 };

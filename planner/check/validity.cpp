@@ -43,8 +43,9 @@ CheckPart ValidityChecker::checkEquilibrium(const std::vector<ContactSpec>& stan
   const QuasiStaticReport q = statics_.check(kin_, stance);
   if (!q.feasible) p.violations.push_back(q.reason);
   std::ostringstream os;
-  os << q.supporting_contacts << " supporting contacts; friction margin " << fmt("%.1f", q.margin)
-     << " N; worst torque " << fmt("%.0f", q.worst_torque_ratio * 100) << "% of its limit ("
+  os << q.supporting_contacts << " supporting contacts; friction margin "
+     << (std::isnan(q.margin) ? std::string("not computed") : fmt("%.1f", q.margin) + " N") << "; worst torque "
+     << fmt("%.0f", q.worst_torque_ratio * 100) << "% of its limit ("
      << (q.worst_joint.empty() ? "-" : q.worst_joint) << "); balance residual " << fmt("%.1e", q.residual)
      << " of the weight";
   p.summary = os.str();

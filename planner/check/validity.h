@@ -60,11 +60,16 @@ class ValidityChecker {
   // The equilibrium LPs warm-started (QuasiStaticChecker::setWarmStart): same
   // verdicts, faster along a trajectory.
   void setWarmStart(bool on) { statics_.setWarmStart(on); }
-  // Both, as every caller that checks the samples of a trajectory one after
-  // the other for their verdicts uses them: a 2 cm cutoff, warm LPs.
+  // The friction margin's LP skipped (QuasiStaticChecker::setMarginComputed):
+  // same verdicts, the summary's margin "not computed".
+  void setMarginComputed(bool on) { statics_.setMarginComputed(on); }
+  // All three, as every caller that checks the samples of a trajectory one
+  // after the other for their verdicts uses them: a 2 cm cutoff, warm LPs,
+  // no margin LP.
   void checkVerdictsInSequence() {
     setClearanceCutoff(0.02);
     setWarmStart(true);
+    setMarginComputed(false);
   }
 
  private:
