@@ -650,6 +650,19 @@ void forEachChairPlanCheck(const Scenario& sc,
 }
 }  // namespace
 
+// Every program that runs posture generators allocates with jemalloc
+// (planner/CMakeLists.txt): malloc resolves to it, not to glibc's.
+TEST(PostureGenerator, JemallocIsTheAllocatorInUse) {
+  for (const char* name : {"malloc", "free", "mallctl"}) {
+    void* sym = dlsym(RTLD_DEFAULT, name);
+    ASSERT_NE(sym, nullptr) << name;
+    Dl_info info{};
+    ASSERT_NE(dladdr(sym, &info), 0) << name;
+    EXPECT_NE(std::string(info.dli_fname).find("jemalloc"), std::string::npos)
+        << name << " resolves to " << info.dli_fname;
+  }
+}
+
 // The independent check restarts each LP from the previous call's basis: one
 // checker kept warm must give the same verdicts, margins and torque ratios as
 // a fresh checker for each call.
