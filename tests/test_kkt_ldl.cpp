@@ -91,6 +91,15 @@ int negativeEigenvalues(const Eigen::MatrixXd& m) {
   return static_cast<int>((ev.array() < 0).count());
 }
 
+// The columns of L from the first of its last columns that are full below
+// the diagonal: the block factor() eliminates densely.
+int fullTrailingColumns(const Factors& f) {
+  const int n = static_cast<int>(f.count.size());
+  int t = n;
+  while (t > 0 && f.count[t - 1] == n - t) --t;
+  return n - t;
+}
+
 TEST(KktLdl, SolvesIpoptsAugmentedSystemsWithTheirInertia) {
   // Sizes of the posture problems (about 90 variables, 30 equality and 140
   // inequality rows) and smaller ones.
@@ -106,6 +115,31 @@ TEST(KktLdl, SolvesIpoptsAugmentedSystemsWithTheirInertia) {
     const Eigen::VectorXd ref = k.dense.fullPivLu().solve(b);
     EXPECT_LT((k.dense * x - b).norm(), 1e-9 * b.norm()) << "seed " << seed;
     EXPECT_LT((x - ref).norm(), 1e-8 * (1 + ref.norm())) << "seed " << seed;
+    if (seed > 3) {  // most of the variables and equality rows eliminated densely
+      EXPECT_GE(fullTrailingColumns(f), (nx + mc) * 3 / 4) << "seed " << seed;
+    }
+  }
+}
+
+// Sparser Jacobians (a posture problem's forces touch few rows) leave some
+// variables out of the dense trailing block: their columns, with positive
+// pivots and many rows in the block, update it as the inequality rows' do.
+// Same solutions and inertia as the dense reference.
+TEST(KktLdl, VariablesLeftOfTheDenseBlockUpdateItToo) {
+  for (unsigned seed = 21; seed <= 24; ++seed) {
+    const int nx = 90, mc = 30, md = 140;
+    const Kkt k = makeKkt(nx, mc, md, seed, 0, 0, seed % 2 ? 0.02 : 0.05);
+    const Factors f = factorize(k);
+    ASSERT_EQ(f.status, 0) << "seed " << seed;
+    const int m = fullTrailingColumns(f);
+    EXPECT_GE(m, 8) << "seed " << seed;
+    int variables_left = 0;
+    for (int c = 0; c < k.n - m; ++c) variables_left += f.perm[c] < nx;
+    EXPECT_GT(variables_left, 0) << "seed " << seed;
+    EXPECT_EQ(f.negative, negativeEigenvalues(k.dense)) << "seed " << seed;
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(k.n, -1, 2);
+    const Eigen::VectorXd x = solveWith(f, b);
+    EXPECT_LT((k.dense * x - b).norm(), 1e-9 * b.norm()) << "seed " << seed;
   }
 }
 

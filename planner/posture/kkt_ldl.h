@@ -19,6 +19,14 @@
 // rank; a zero pivot otherwise, reported as singular so that Ipopt
 // regularizes). The inertia is the count of negative pivots (Sylvester).
 //
+// The elimination is up-looking and sparse, except for the trailing block of
+// columns that are full below the diagonal (most variables and the equality
+// rows once the slacks are condensed: 70-120 of 300-400 rows, most of the
+// work): its Schur complement is formed from the sparse columns' rows in it
+// (the long ones, a torque row's, as two dense symmetric rank updates), then
+// it is factorized densely, in the same order, without pivoting. Perf on
+// bench_posture: the linear algebra's time a fifth lower than all sparse.
+//
 // All state lives in caller-owned arrays, as with HSL's MA27, whose calling
 // sequence Ipopt's linear-solver loader accepts (ipopt_ldl.cpp): two solvers
 // on two threads share nothing.
