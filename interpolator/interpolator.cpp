@@ -100,7 +100,6 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
   to.posture.ipopt_options = opt.posture_ipopt_options;
   to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
-  if (opt.posture_lbfgs_in_kkt) to.posture.linear_solver = "mumps";  // ldl needs a diagonal Hessian block
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap};
   to.verify_samples = opt.verify_samples;
   TransitionSolver solver(sc, to);

@@ -40,9 +40,8 @@ struct InterpolatorOptions {
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out
   std::vector<std::string> posture_ipopt_options;  // "name=value", passed to each posture solve
   // L-BFGS's low-rank part inside the KKT system
-  // (PostureGeneratorOptions::lbfgs_in_kkt), which needs the "mumps" solver.
-  // Off: Sherman-Morrison's extra solves cost little with "ldl".
-  bool posture_lbfgs_in_kkt = false;
+  // (PostureGeneratorOptions::lbfgs_in_kkt).
+  bool posture_lbfgs_in_kkt = true;
   // Transitions solved at once, one solver each (same result for any count).
   int threads = 2;
 };

@@ -143,6 +143,37 @@ TEST(KktLdl, VariablesLeftOfTheDenseBlockUpdateItToo) {
   }
 }
 
+// L-BFGS's low-rank part as rows (Ipopt's limited_memory_aug_solver=extended,
+// PostureGeneratorOptions::lbfgs_in_kkt): rows for the update's vectors V and
+// U, with -1 and +1 on the diagonal, against every variable. The graph stays
+// bipartite, the rows join the dense block, and the solutions and inertia are
+// those of the dense reference.
+TEST(KktLdl, SolvesSystemsWithLbfgsRows) {
+  for (unsigned seed = 31; seed <= 34; ++seed) {
+    const int nx = 90, mc = 30, md = 140, pairs = 6;
+    Kkt k = makeKkt(nx, mc, md, seed);
+    const int n0 = k.n;
+    k.n += 2 * pairs;
+    Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(k.n, k.n);
+    grown.topLeftCorner(n0, n0) = k.dense;
+    k.dense = grown;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-0.3, 0.3);
+    for (int r = 0; r < 2 * pairs; ++r) {
+      const int row = n0 + r;
+      k.add(row, row, r < pairs ? -1.0 : 1.0);  // V's rows, then U's
+      for (int j = 0; j < nx; ++j) k.add(row, j, u(rng));
+    }
+    const Factors f = factorize(k);
+    ASSERT_EQ(f.status, 0) << "seed " << seed;
+    EXPECT_GE(fullTrailingColumns(f), 2 * pairs) << "seed " << seed;
+    EXPECT_EQ(f.negative, negativeEigenvalues(k.dense)) << "seed " << seed;
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(k.n, -1, 2);
+    const Eigen::VectorXd x = solveWith(f, b);
+    EXPECT_LT((k.dense * x - b).norm(), 1e-9 * b.norm()) << "seed " << seed;
+  }
+}
+
 TEST(KktLdl, CondensesTheInequalityRowsOntoTheVariables) {
   // The order eliminates each slack, then its row, then the variables, then
   // the equality rows: L has no more entries than the dense lower triangle

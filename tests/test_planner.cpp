@@ -206,7 +206,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   const Scenario tuned =
       Scenario::load(dir.write("b.yaml", text + "planner: {max_nodes: 77, box_half_sizes: [0.1, 0.2, 0.3], guide_joint_weight: 0.1, "
                                              "depth_weight: 0.02, failure_memory: false, failure_memory_distance: 0.1, "
-                                             "failure_memory_angle: 0.5, posture_linear_solver: mumps}\n"));
+                                             "failure_memory_angle: 0.5, posture_linear_solver: mumps, "
+                                             "posture_lbfgs_in_kkt: true}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -217,6 +218,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_DOUBLE_EQ(p.failure_memory_angle, 0.5);
   EXPECT_EQ(p.posture.linear_solver, "mumps");
   EXPECT_EQ(plannerParameters(plain).posture.linear_solver, "ldl");
+  EXPECT_TRUE(p.posture.lbfgs_in_kkt);
+  EXPECT_FALSE(plannerParameters(plain).posture.lbfgs_in_kkt);  // the planner's default (contact_planner.cpp)
   EXPECT_TRUE(plannerParameters(plain).failure_memory);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
@@ -226,7 +229,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {guide_joint_weight: 0}\n", "planner.guide_joint_weight"},
            {"planner: {failure_memory_distance: -0.1}\n", "planner.failure_memory_distance"},
            {"planner: {failure_memory: maybe}\n", "planner.failure_memory"},
-           {"planner: {posture_linear_solver: pardiso}\n", "planner.posture_linear_solver"}}) {
+           {"planner: {posture_linear_solver: pardiso}\n", "planner.posture_linear_solver"},
+           {"planner: {posture_lbfgs_in_kkt: sometimes}\n", "planner.posture_lbfgs_in_kkt"}}) {
     const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
     try {
       plannerParameters(sc);

@@ -151,10 +151,10 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   o->SetStringValue("hessian_approximation", opt_.hessian == "lbfgs" ? "limited-memory" : "exact");
   if (opt_.hessian == "lbfgs" && opt_.lbfgs_in_kkt) o->SetStringValue("limited_memory_aug_solver", "extended");
   if (opt_.linear_solver == "ldl") {
-    if (opt_.hessian == "analytic" || (opt_.hessian == "lbfgs" && opt_.lbfgs_in_kkt))
+    if (opt_.hessian == "analytic")
       throw std::invalid_argument(
-          "PostureGeneratorOptions::linear_solver \"ldl\" needs a diagonal Hessian block (hessian lbfgs without "
-          "lbfgs_in_kkt, or diagonal); use \"mumps\" with the others");
+          "PostureGeneratorOptions::linear_solver \"ldl\" needs a diagonal Hessian block (hessian lbfgs or "
+          "diagonal); use \"mumps\" with hessian analytic");
     kkt::registerWithIpopt();
     o->SetStringValue("linear_solver", "ma27");  // the loader's name for what registerWithIpopt supplies
     o->SetStringValue("linear_system_scaling", "none");

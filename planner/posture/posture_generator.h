@@ -23,20 +23,23 @@ struct PostureGeneratorOptions {
   // the Lagrangian) or "diagonal" (the cost's, constant).
   std::string hessian = "lbfgs";
   // L-BFGS's low-rank part as extra rows of the KKT system, factorized with
-  // it once per iteration, instead of Sherman-Morrison's dozen MUMPS solves
-  // per iteration around it (Ipopt's limited_memory_aug_solver=extended):
-  // each MUMPS call has a fixed cost that these small systems do not
-  // amortize. bench_posture: successes 1.2-1.8 times faster at the same
-  // iterations, failures 1.5-1.8. Off by default: the witnesses differ, and
-  // the chair's search, chaotic in them, then did not solve in 3,000 nodes
-  // (README "Posture generator"). Needs linear_solver "mumps": with "ldl"
-  // Sherman-Morrison's solves cost little (bench_posture: "ldl" is faster).
-  bool lbfgs_in_kkt = false;
+  // it once per iteration (Ipopt's limited_memory_aug_solver=extended: rows
+  // for the update's vectors, with -1 and +1 diagonals), instead of
+  // Sherman-Morrison's dozen solves per iteration around it. With "ldl" the
+  // rows join the dense trailing block (kkt_ldl.h); bench_posture (session
+  // 9): solves per call a third, an iteration about 15% cheaper. With
+  // "mumps" each call has a fixed cost that these small systems do not
+  // amortize: 1.2-1.8 times faster (session 7). The witnesses differ from
+  // Sherman-Morrison's, and searches are chaotic in them: the planner keeps
+  // Sherman-Morrison by default (PlannerParameters; README "Posture
+  // generator"), the interpolator uses the rows.
+  bool lbfgs_in_kkt = true;
   // Ipopt's linear solver: "ldl" (kkt_ldl.h: a sparse LDL^T in an order
   // these KKT systems need no pivoting in, reentrant, so that two generators
   // on two threads run in parallel) or "mumps" (Debian's Ipopt's own,
-  // serialized by a process-wide lock). "ldl" needs a diagonal Hessian block:
-  // hessian "lbfgs" without lbfgs_in_kkt, or "diagonal".
+  // serialized by a process-wide lock). "ldl" needs the Hessian block
+  // diagonal but for L-BFGS's rows: hessian "lbfgs" or "diagonal", not
+  // "analytic".
   std::string linear_solver = "ldl";
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).

@@ -8,6 +8,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   const YamlField& f = *sc.planner_section;
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
+               "posture_lbfgs_in_kkt",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -46,6 +47,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     if (v != "ldl" && v != "mumps") f["posture_linear_solver"].fail("ldl or mumps");
     p.posture.linear_solver = v;
   }
+  if (f.has("posture_lbfgs_in_kkt")) p.posture.lbfgs_in_kkt = f["posture_lbfgs_in_kkt"].boolean();
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
     if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
