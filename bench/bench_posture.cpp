@@ -2,13 +2,15 @@
 // scene (random contact subsets, start guesses, floating contacts; some
 // infeasible): success rate, time per call for successes and for failures,
 // iterations, and how many successes the independent check accepts.
-// Usage: bench_posture [--problems N] [--seed S] [--max-seconds T] [--max-iterations N]
-//                      [--cutoff M] [--hessian H] [--linear-solver ldl|mumps] [--ipopt name=value]...
+// Usage: bench_posture --help.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
+#include <memory>
 #include <random>
+#include <stdexcept>
+
+#include <CLI/CLI.hpp>
 
 #include "planner/check/validity.h"
 #include "planner/posture/heap_tuning.h"
@@ -92,18 +94,33 @@ int main(int argc, char** argv) {
   int n = 100;
   unsigned seed = 1;
   PostureGeneratorOptions opt;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--problems")) n = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--seed")) seed = static_cast<unsigned>(std::atoi(argv[i + 1]));
-    else if (!std::strcmp(argv[i], "--ipopt")) opt.ipopt_options.push_back(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-seconds")) opt.max_seconds = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--max-iterations")) opt.max_iterations = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--hessian")) opt.hessian = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--linear-solver")) opt.linear_solver = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--cutoff")) opt.problem.collision_cutoff = std::atof(argv[i + 1]);
-  }
+  bool lbfgs_rows = opt.lbfgs_in_kkt;
+  CLI::App app{"The posture generator on a fixed, seeded set of problems from the chair scene (random contact\n"
+               "subsets, start guesses, floating contacts; some infeasible): success rate, time per call for\n"
+               "successes and for failures (median, 90th percentile), iterations, and how many successes the\n"
+               "independent check accepts."};
+  app.add_option("--problems", n, "number of problems")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--seed", seed, "seed of the problem set")->capture_default_str();
+  app.add_option("--max-seconds", opt.max_seconds, "CPU time limit per call, s")->capture_default_str();
+  app.add_option("--max-iterations", opt.max_iterations, "iteration limit per call")->capture_default_str();
+  app.add_option("--cutoff", opt.problem.collision_cutoff, "collision pairs farther than this at the start are left out, m")
+      ->capture_default_str();
+  app.add_option("--hessian", opt.hessian, "lbfgs, analytic or diagonal")->capture_default_str();
+  app.add_option("--linear-solver", opt.linear_solver, "ldl or mumps")->capture_default_str();
+  app.add_option("--lbfgs-rows", lbfgs_rows, "L-BFGS's low-rank part as rows of the KKT system (else Sherman-Morrison)")
+      ->capture_default_str();
+  app.add_option("--ipopt", opt.ipopt_options, "further Ipopt option name=value (repeatable)");
+  CLI11_PARSE(app, argc, argv);
+  opt.lbfgs_in_kkt = lbfgs_rows;
   const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml");
-  PostureGenerator pg(sc.robot, sc.scene, opt);
+  std::unique_ptr<PostureGenerator> made;
+  try {
+    made = std::make_unique<PostureGenerator>(sc.robot, sc.scene, opt);
+  } catch (const std::invalid_argument& e) {  // a bad option: said, not aborted on
+    std::fprintf(stderr, "bench_posture: %s\n", e.what());
+    return 2;
+  }
+  PostureGenerator& pg = *made;
   ValidityChecker checker(sc.robot, sc.scene);
   const auto problems = makeProblems(sc, n, seed);
 
