@@ -53,6 +53,16 @@ void permutedUpper(int n, int nz, const int* irn, const int* jcn, const int* pin
   }
 }
 
+// Where the dense trailing block starts: the columns from there on are full
+// below the diagonal. In these systems it is most of the variables and the
+// equality rows once the slacks are condensed (70-120 of 300-400 rows, about
+// half of the factorization's work), and it is factorized densely.
+int denseStart(int n, const int* colcount) {
+  int t = n;
+  while (t > 0 && colcount[t - 1] == n - t) --t;
+  return n - t >= kMinDense ? t : n;
+}
+
 }  // namespace
 
 long analyse(int n, int nz, const int* irn, const int* jcn, int* perm, int* parent, int* colcount, std::string* why) {
@@ -137,16 +147,6 @@ long analyse(int n, int nz, const int* irn, const int* jcn, int* perm, int* pare
       }
   }
   return total;
-}
-
-// Where the dense trailing block starts: the columns from there on are full
-// below the diagonal. In these systems it is the variables and the equality
-// rows once the slacks are condensed (about a third of the rows, nearly all
-// of the work), and it is factorized densely.
-int denseStart(int n, const int* colcount) {
-  int t = n;
-  while (t > 0 && colcount[t - 1] == n - t) --t;
-  return n - t >= kMinDense ? t : n;
 }
 
 int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const int* perm, const int* parent,
