@@ -94,7 +94,6 @@ int main(int argc, char** argv) {
   int n = 100;
   unsigned seed = 1;
   PostureGeneratorOptions opt;
-  bool lbfgs_rows = opt.lbfgs_in_kkt;
   CLI::App app{"The posture generator on a fixed, seeded set of problems from the chair scene (random contact\n"
                "subsets, start guesses, floating contacts; some infeasible): success rate, time per call for\n"
                "successes and for failures (median, 90th percentile), iterations, and how many successes the\n"
@@ -107,11 +106,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--hessian", opt.hessian, "lbfgs, analytic or diagonal")->capture_default_str();
   app.add_option("--linear-solver", opt.linear_solver, "ldl or mumps")->capture_default_str();
-  app.add_option("--lbfgs-rows", lbfgs_rows, "L-BFGS's low-rank part as rows of the KKT system (else Sherman-Morrison)")
+  app.add_option("--lbfgs-rows", opt.lbfgs_in_kkt, "L-BFGS's low-rank part as rows of the KKT system (else Sherman-Morrison)")
       ->capture_default_str();
   app.add_option("--ipopt", opt.ipopt_options, "further Ipopt option name=value (repeatable)");
   CLI11_PARSE(app, argc, argv);
-  opt.lbfgs_in_kkt = lbfgs_rows;
   const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml");
   std::unique_ptr<PostureGenerator> made;
   try {

@@ -1,6 +1,7 @@
 #include "planner/posture/kkt_ldl.h"
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -23,7 +24,7 @@ struct Scratch {
   std::vector<int> work;                     // factor's flag, filled and pattern
   std::vector<double> y;                     // factor's row being eliminated
   std::vector<double> schur, scale;          // the dense trailing block, its pivots' scales
-  std::vector<int> heavy;                    // columns whose block rows are gathered densely
+  std::vector<std::pair<int, int>> heavy;    // columns whose block rows are gathered densely, where those start
   Eigen::MatrixXd g_pos, g_neg;              // those rows times sqrt|D|, by the sign of D
 };
 Scratch& scratch() {
@@ -57,9 +58,12 @@ void permutedUpper(int n, int nz, const int* irn, const int* jcn, const int* pin
 // below the diagonal. In these systems it is most of the variables and the
 // equality rows once the slacks are condensed (70-120 of 300-400 rows, about
 // half of the factorization's work), and it is factorized densely.
-int denseStart(int n, const int* colcount) {
+// `count(c)`: the entries below the diagonal in column c of L (the analysis's
+// colcount in factor, Lp's differences in solve: the same rule for both).
+template <class Count>
+int denseStart(int n, Count count) {
   int t = n;
-  while (t > 0 && colcount[t - 1] == n - t) --t;
+  while (t > 0 && count(t - 1) == n - t) --t;
   return n - t >= kMinDense ? t : n;
 }
 
@@ -162,7 +166,7 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
 
   Lp[0] = 0;
   for (int c = 0; c < n; ++c) Lp[c + 1] = Lp[c] + colcount[c];
-  const int t = denseStart(n, colcount), m = n - t;
+  const int t = denseStart(n, [colcount](int c) { return colcount[c]; }), m = n - t;
   std::vector<int>& work = s.work;  // flag[n], filled[n], pattern[n]
   work.assign(3 * static_cast<std::size_t>(n), 0);
   int* flag = work.data();
@@ -239,7 +243,7 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
   // scaled by sqrt|D|, and S -= G+ G+^T - G- G-^T as two symmetric rank
   // updates (Eigen's blocked kernels).
   for (int j = 0; j < m; ++j) scale[j] = std::abs(S[static_cast<std::size_t>(j) * m + j]);  // |a_jj|
-  std::vector<int>& heavy = s.heavy;
+  auto& heavy = s.heavy;
   heavy.clear();
   for (int i = 0; i < t; ++i) {
     int b = Lp[i + 1];
@@ -247,7 +251,7 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
     const int e = Lp[i + 1];
     for (int p = b; p < e; ++p) scale[Li[p] - t] += std::abs(Lx[p] * D[i] * Lx[p]);
     if (e - b >= kHeavyColumn) {
-      heavy.push_back(i);
+      heavy.emplace_back(i, b);
       continue;
     }
     for (int p = b; p < e; ++p) {
@@ -259,16 +263,16 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
   }
   if (!heavy.empty()) {
     int npos = 0, nneg = 0;
-    for (int i : heavy) (D[i] > 0 ? npos : nneg)++;
+    for (const auto& [i, b] : heavy) (D[i] > 0 ? npos : nneg)++;
     Eigen::MatrixXd& Gp = s.g_pos;
     Eigen::MatrixXd& Gn = s.g_neg;
     Gp.setZero(m, npos);
     Gn.setZero(m, nneg);
     int ip = 0, in = 0;
-    for (int i : heavy) {
+    for (const auto& [i, b] : heavy) {
       const double r = std::sqrt(std::abs(D[i]));
       double* g = D[i] > 0 ? Gp.col(ip++).data() : Gn.col(in++).data();
-      for (int p = Lp[i + 1] - 1; p >= Lp[i] && Li[p] >= t; --p) g[Li[p] - t] = Lx[p] * r;
+      for (int p = b; p < Lp[i + 1]; ++p) g[Li[p] - t] = Lx[p] * r;
     }
     Eigen::Map<Eigen::MatrixXd> Sm(S.data(), m, m);
     if (npos) Sm.selfadjointView<Eigen::Lower>().rankUpdate(Gp, -1.0);
@@ -303,9 +307,7 @@ void solve(int n, const int* perm, const int* Lp, const int* Li, const double* L
            double* work) {
   // Columns from t on are the dense trailing block (factor): each holds every
   // row below its diagonal, contiguously in Lx, and is swept without indices.
-  int t = n;
-  while (t > 0 && Lp[t] - Lp[t - 1] == n - t) --t;
-  if (n - t < kMinDense) t = n;
+  const int t = denseStart(n, [Lp](int c) { return Lp[c + 1] - Lp[c]; });
   for (int k = 0; k < n; ++k) work[k] = b[perm[k]];
   for (int j = 0; j < t; ++j) {
     const double xj = work[j];
