@@ -266,20 +266,33 @@ struct ContactPlanner::Impl {
     return id;
   }
 
-  // Solves a batch of requests, on two generators at once when the planner
-  // has two (p.threads); results in request order. Request i always goes to
-  // generator i % threads, so the results do not depend on timing.
-  std::vector<PostureResult> solveAll(const std::vector<PostureRequest>& rs) {
-    std::vector<PostureResult> out(rs.size());
-    std::vector<char> ran(rs.size(), 0);  // a cancellation leaves the rest unsolved (BadInput, never used)
-    const std::size_t workers = std::min(pgs.size(), rs.size());
+  // Solves a batch of requests on the planner's generators at once (p.threads),
+  // each taking the next unsolved request when it is free; results in request
+  // order. A solve depends on its request only (each builds its own problem
+  // and Ipopt algorithm), so the results do not depend on which generator
+  // took it, nor on timing. Requests beyond the posture-call budget, and
+  // those left when a cancellation comes, are not solved: `ran` says which were.
+  struct Batch {
+    std::vector<PostureResult> results;
+    std::vector<char> ran;
+  };
+  // `budgeted` false: every request is solved (a plan's settled stances).
+  Batch solveAll(const std::vector<PostureRequest>& rs, bool budgeted = true) {
+    Batch b;
+    b.results.resize(rs.size());
+    b.ran.assign(rs.size(), 0);
+    const long size = static_cast<long>(rs.size());
+    const std::size_t n =
+        static_cast<std::size_t>(budgeted ? std::clamp<long>(p.max_posture_calls - stats.posture_calls, 0, size) : size);
+    std::atomic<std::size_t> next{0};
     auto run = [&](std::size_t w) {
-      for (std::size_t i = w; i < rs.size(); i += workers) {
+      for (std::size_t i; (i = next.fetch_add(1)) < n;) {
         if (cancel && cancel->load()) break;
-        out[i] = pgs[w]->solve(rs[i]);
-        ran[i] = 1;
+        b.results[i] = pgs[w]->solve(rs[i]);
+        b.ran[i] = 1;
       }
     };
+    const std::size_t workers = std::min(pgs.size(), n);
     if (workers <= 1) {
       run(0);
     } else {
@@ -288,12 +301,12 @@ struct ContactPlanner::Impl {
       run(0);
       for (auto& t : pool) t.join();
     }
-    for (std::size_t i = 0; i < out.size(); ++i)
-      if (ran[i]) {
+    for (std::size_t i = 0; i < rs.size(); ++i)
+      if (b.ran[i]) {
         ++stats.posture_calls;
-        if (!out[i].success()) ++stats.posture_failures;
+        if (!b.results[i].success()) ++stats.posture_failures;
       }
-    return out;
+    return b;
   }
 
   void traceCall(const std::string& what, const PostureResult& res) const {
@@ -302,10 +315,11 @@ struct ContactPlanner::Impl {
               std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
   }
 
-  void removalSons(int ni) {
-    if (nodes[ni].contacts.size() < 2 || !budgetLeft()) return;
-    std::vector<PostureRequest> requests;
-    std::vector<std::size_t> removed;
+  // The removal sons' requests of node ni: each contact geometric only in
+  // turn, unless the stance without it is a node already. `removed` gets
+  // the index of each request's contact.
+  void removalRequests(int ni, std::vector<PostureRequest>& requests, std::vector<std::size_t>& removed) {
+    if (nodes[ni].contacts.size() < 2) return;
     for (std::size_t c = 0; c < nodes[ni].contacts.size(); ++c) {
       std::vector<ContactSpec> rest = nodes[ni].contacts;
       rest.erase(rest.begin() + c);
@@ -318,21 +332,21 @@ struct ContactPlanner::Impl {
       requests.push_back(std::move(r));
       removed.push_back(c);
     }
-    const std::vector<PostureResult> results = solveAll(requests);
-    for (std::size_t k = 0; k < requests.size() && goal_node < 0; ++k) {
-      const std::size_t c = removed[k];
-      traceCall("remove " + sc.robot->spots()[nodes[ni].contacts[c].spot].name, results[k]);
-      if (!results[k].success()) continue;
-      Node son;
-      son.transition = requests[k].contacts;
-      son.contacts = nodes[ni].contacts;
-      son.contacts.erase(son.contacts.begin() + c);
-      son.q = results[k].configuration;
-      son.parent = ni;
-      son.change = Change::Removed;
-      son.changed_spot = nodes[ni].contacts[c].spot;
-      addNode(son);
-    }
+  }
+
+  // The son that removing contact c of node ni makes, from its request's result.
+  void acceptRemoval(int ni, std::size_t c, const PostureRequest& request, const PostureResult& res) {
+    traceCall("remove " + sc.robot->spots()[nodes[ni].contacts[c].spot].name, res);
+    if (!res.success()) return;
+    Node son;
+    son.transition = request.contacts;
+    son.contacts = nodes[ni].contacts;
+    son.contacts.erase(son.contacts.begin() + c);
+    son.q = res.configuration;
+    son.parent = ni;
+    son.change = Change::Removed;
+    son.changed_spot = nodes[ni].contacts[c].spot;
+    addNode(son);
   }
 
   // A pair generator's next request: its best remaining volume (or a random
@@ -428,7 +442,9 @@ struct ContactPlanner::Impl {
   int nextSon(int gi) {
     Candidate cand;
     while (budgetLeft() && goal_node < 0 && nextCandidate(gi, cand)) {
-      const int id = acceptCandidate(gi, cand, solveAll({cand.request})[0]);
+      const Batch b = solveAll({cand.request});
+      if (!b.ran[0]) return -1;  // cancelled
+      const int id = acceptCandidate(gi, cand, b.results[0]);
       if (id >= 0) return id;
     }
     return -1;
@@ -467,12 +483,11 @@ struct ContactPlanner::Impl {
     return true;
   }
 
-  void expand(int ni) {
-    ++stats.nodes_expanded;
-    traceExpansion(ni);
-    removalSons(ni);
-    if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return;
+  // The pair generators of node ni, one per pair (spot, surface) that the
+  // failure memory and the reachability test leave to try.
+  std::vector<int> pairGenerators(int ni) {
     std::vector<int> pairs;
+    if (nodes[ni].contacts.size() >= static_cast<std::size_t>(p.max_contacts)) return pairs;
     for (int spot : sc.allowed_spots) {
       bool used = false;
       for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
@@ -491,30 +506,88 @@ struct ContactPlanner::Impl {
         pairs.push_back(static_cast<int>(gens.size()) - 1);
       }
     }
+    return pairs;
+  }
+
+  // Eager sons (the ablation): every removal son, then up to
+  // eager_candidates_per_pair sons of each pair, one after the other.
+  void expandEagerly(int ni) {
+    if (budgetLeft()) {
+      std::vector<PostureRequest> requests;
+      std::vector<std::size_t> removed;
+      removalRequests(ni, requests, removed);
+      const Batch b = solveAll(requests);
+      for (std::size_t k = 0; k < requests.size() && goal_node < 0; ++k)
+        if (b.ran[k]) acceptRemoval(ni, removed[k], requests[k], b.results[k]);
+    }
+    const std::vector<int> pairs = pairGenerators(ni);
+    const int sons = p.optimized_candidates ? p.eager_candidates_per_pair : p.random_samples_per_pair;
+    for (int gi : pairs)
+      for (int k = 0; k < sons && budgetLeft() && goal_node < 0; ++k)
+        if (nextSon(gi) < 0) break;
+  }
+
+  // Expands node ni; `selected_from` is the pair generator that made it (-1
+  // for none), whose next son is due now that this one is taken (lazy sons,
+  // paper 2.8). The calls that do not depend on each other's results go to
+  // the generators as one batch: the removal sons, each pair's first son, and
+  // the selected generator's next candidate. Their results are then taken in
+  // the order of the sequential search (removals, pairs, the next son), and a
+  // candidate that makes no son goes on alone (its pair's remaining volumes),
+  // so the tree is the one that solving them one by one would grow.
+  void expand(int ni, int selected_from) {
+    ++stats.nodes_expanded;
+    traceExpansion(ni);
     if (!p.lazy_sons) {
-      const int sons = p.optimized_candidates ? p.eager_candidates_per_pair : p.random_samples_per_pair;
-      for (int gi : pairs)
-        for (int k = 0; k < sons && budgetLeft() && goal_node < 0; ++k)
-          if (nextSon(gi) < 0) break;
+      expandEagerly(ni);
       return;
     }
-    // Lazy sons: each pair's first son. The first candidates are independent
-    // of each other: solved as one batch; a pair whose first candidate makes
-    // no son goes on sequentially (its remaining volumes).
-    if (!budgetLeft() || goal_node >= 0) return;
-    std::vector<Candidate> cands(pairs.size());
+    if (!budgetLeft()) return;
     std::vector<PostureRequest> requests;
+    std::vector<std::size_t> removed;
+    removalRequests(ni, requests, removed);
+    const std::size_t n_removals = requests.size();
+    const std::vector<int> pairs = pairGenerators(ni);
+    std::vector<Candidate> cands(pairs.size());
     std::vector<int> with_candidate;
     for (std::size_t k = 0; k < pairs.size(); ++k)
       if (nextCandidate(pairs[k], cands[k])) {
         requests.push_back(cands[k].request);
         with_candidate.push_back(static_cast<int>(k));
       }
-    const std::vector<PostureResult> results = solveAll(requests);
-    for (std::size_t j = 0; j < with_candidate.size() && goal_node < 0; ++j) {
-      const int k = with_candidate[j];
-      if (acceptCandidate(pairs[k], cands[k], results[j]) < 0 && results[j].success()) nextSon(pairs[k]);
+    // The selected generator's next candidate, taken from it now: put back if
+    // the search ends before its turn (a goal whose plan cannot be exported
+    // lets the search go on, and that generator must still hold it). A random
+    // candidate draws from the search's generator of random numbers, in the
+    // order of the sequential search: drawn in its turn, not ahead.
+    Candidate next;
+    std::optional<PairGenerator> before;
+    if (selected_from >= 0 && p.optimized_candidates) {
+      before = gens[selected_from];
+      if (nextCandidate(selected_from, next)) requests.push_back(next.request);
+      else before.reset();
     }
+    const Batch b = solveAll(requests);
+    for (std::size_t k = 0; k < n_removals && goal_node < 0; ++k)
+      if (b.ran[k]) acceptRemoval(ni, removed[k], requests[k], b.results[k]);
+    if (budgetLeft() && goal_node < 0) {
+      for (std::size_t j = 0; j < with_candidate.size() && goal_node < 0; ++j) {
+        const std::size_t r = n_removals + j;
+        if (!b.ran[r]) break;  // cancelled, or out of posture calls
+        const int k = with_candidate[j];
+        if (acceptCandidate(pairs[k], cands[k], b.results[r]) < 0 && b.results[r].success()) nextSon(pairs[k]);
+      }
+    }
+    if (selected_from < 0) return;
+    if (before) {
+      const std::size_t r = requests.size() - 1;
+      if (!(budgetLeft() && goal_node < 0 && b.ran[r])) {
+        gens[selected_from] = *before;
+        return;
+      }
+      if (acceptCandidate(selected_from, next, b.results[r]) >= 0) return;
+    }
+    nextSon(selected_from);
   }
 
   // A witness for the stance `contacts` between a removal (witness `removed`)
@@ -534,7 +607,7 @@ struct ContactPlanner::Impl {
         ++stats.posture_calls;
         if (!res.success()) ++stats.posture_failures;
       } else {
-        res = solveAll({r})[0];
+        res = solveAll({r}, false).results[0];
       }
       if (res.success() && valid(res.configuration)) return res.configuration;
       return std::nullopt;
@@ -666,9 +739,7 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
     const Impl::Entry e = I.open.top();
     I.open.pop();
     if (I.deadPath(e.node)) continue;
-    const int gen = I.nodes[e.node].generator;
-    I.expand(e.node);
-    if (gen >= 0 && I.p.lazy_sons) I.nextSon(gen);  // its pair's next son, now that this one is taken
+    I.expand(e.node, I.p.lazy_sons ? I.nodes[e.node].generator : -1);
     I.stats.seconds = I.elapsed();
     if (progress && I.stats.seconds - last_report >= 0.5) {
       progress(I.stats);
