@@ -88,9 +88,9 @@ int main(int argc, char** argv) {
     if (tty) std::fprintf(stderr, "\n");
     const auto& s = r.stats;
     std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated, %ld expanded, %ld posture calls (%ld failed), "
-                "%ld pairs skipped by the failure memory\n",
+                "%ld pairs skipped by the failure memory, %ld calls solved ahead and not used\n",
                 sc.name.c_str(), acyclic::toString(r.status), s.seconds, s.nodes_generated, s.nodes_expanded,
-                s.posture_calls, s.posture_failures, s.pairs_remembered);
+                s.posture_calls, s.posture_failures, s.pairs_remembered, s.calls_ahead_unused);
     if (!r.solved()) {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
       return 1;

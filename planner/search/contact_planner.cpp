@@ -438,14 +438,58 @@ struct ContactPlanner::Impl {
     return addNode(son, true);
   }
 
-  // The next son of a pair generator, or -1 when it has none left.
+  // The next son of a pair generator, or -1 when it has none left: its
+  // candidates in turn until one makes a son. With two posture generators,
+  // two candidates at a time: one that fails leaves the pair's volumes as
+  // they were but for its own, so the candidate after it is known before it
+  // is solved. One solved ahead whose turn does not come (the one before it
+  // made a son, or was feasible and dropped: that one's volume parts change
+  // what comes next) goes back to the pair, and its call is counted apart
+  // (stats.calls_ahead_unused): the tree is the one of solving them one by one.
   int nextSon(int gi) {
-    Candidate cand;
-    while (budgetLeft() && goal_node < 0 && nextCandidate(gi, cand)) {
-      const Batch b = solveAll({cand.request});
-      if (!b.ran[0]) return -1;  // cancelled
-      const int id = acceptCandidate(gi, cand, b.results[0]);
-      if (id >= 0) return id;
+    const std::size_t ahead = p.optimized_candidates ? pgs.size() : 1;  // random draws: one at a time
+    while (budgetLeft() && goal_node < 0) {
+      std::vector<Candidate> cands;
+      std::vector<std::vector<std::pair<double, SearchVolume>>> left;  // the pair's volumes after each is taken
+      for (std::size_t k = 0; k < ahead; ++k) {
+        Candidate c;
+        if (!nextCandidate(gi, c)) break;
+        cands.push_back(std::move(c));
+        if (ahead > 1) left.push_back(gens[gi].volumes);
+      }
+      if (cands.empty()) return -1;
+      std::vector<PostureRequest> requests;
+      for (const auto& c : cands) requests.push_back(c.request);
+      const Batch b = solveAll(requests);
+      // Candidates k.. are not used: back to the pair, before the parts that
+      // candidate k - 1 added (their order is the sequential search's).
+      auto giveBack = [&](std::size_t k) {
+        std::vector<std::pair<double, SearchVolume>> v = left[k - 1];
+        v.insert(v.end(), gens[gi].volumes.begin() + static_cast<long>(left.back().size()), gens[gi].volumes.end());
+        gens[gi].volumes = std::move(v);
+        for (std::size_t j = k; j < cands.size(); ++j)
+          if (b.ran[j]) {
+            --stats.posture_calls;
+            if (!b.results[j].success()) --stats.posture_failures;
+            ++stats.calls_ahead_unused;
+          }
+      };
+      for (std::size_t k = 0; k < cands.size(); ++k) {
+        if (k > 0 && (!budgetLeft() || goal_node >= 0)) {
+          giveBack(k);
+          return -1;
+        }
+        if (!b.ran[k]) {  // cancelled, or out of posture calls
+          if (k + 1 < cands.size()) giveBack(k + 1);
+          return -1;
+        }
+        const int id = acceptCandidate(gi, cands[k], b.results[k]);
+        if (id >= 0 || b.results[k].success()) {
+          if (k + 1 < cands.size()) giveBack(k + 1);
+          if (id >= 0) return id;
+          break;  // feasible but dropped: the next candidates from the volumes as they are now
+        }
+      }
     }
     return -1;
   }

@@ -68,6 +68,7 @@ struct PlannerParameters {
 struct PlanningStats {
   long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
   long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
+  long calls_ahead_unused = 0;  // solved ahead on an idle generator, their turn never came (not in posture_calls)
   double seconds = 0, best_potential = 0;
 };
 
