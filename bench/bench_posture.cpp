@@ -108,6 +108,9 @@ int main(int argc, char** argv) {
   app.add_option("--linear-solver", opt.linear_solver, "ldl or mumps")->capture_default_str();
   app.add_option("--lbfgs-rows", opt.lbfgs_in_kkt, "L-BFGS's low-rank part as rows of the KKT system (else Sherman-Morrison)")
       ->capture_default_str();
+  app.add_option("--stop-at-restoration", opt.stop_at_restoration,
+                 "give up when Ipopt enters its restoration phase (the planner's setting)")
+      ->capture_default_str();
   app.add_option("--ipopt", opt.ipopt_options, "further Ipopt option name=value (repeatable)");
   CLI11_PARSE(app, argc, argv);
   const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml");

@@ -144,6 +144,48 @@ TEST(ContactPlanner, SitDownIsPlannedWithBothThighsOnTheSeat) {
   EXPECT_EQ(thighs, 2);
 }
 
+// Two posture generators solve a pair's candidates two at a time, and an
+// expansion's calls as one batch; the search takes their results in the
+// order of solving them one by one: the same tree, the same plan.
+TEST(ContactPlanner, CallsSolvedAheadLeaveTheTreeAsItWas) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
+  PlannerParameters one = plannerParameters(sc), two = one;
+  one.threads = 1;
+  two.threads = 2;
+  const PlanningResult a = ContactPlanner(sc, one).plan();
+  const PlanningResult b = ContactPlanner(sc, two).plan();
+  ASSERT_TRUE(a.solved() && b.solved()) << a.reason << " / " << b.reason;
+  EXPECT_EQ(a.stats.nodes_generated, b.stats.nodes_generated);
+  EXPECT_EQ(a.stats.nodes_expanded, b.stats.nodes_expanded);
+  EXPECT_EQ(a.stats.posture_calls, b.stats.posture_calls);
+  EXPECT_EQ(a.stats.posture_failures, b.stats.posture_failures);
+  EXPECT_EQ(a.stats.calls_ahead_unused, 0);
+  EXPECT_GT(b.stats.calls_ahead_unused, 0);  // candidates were solved ahead, and given back
+  Plan pa = a.plan, pb = b.plan;
+  pa.stats.seconds = pb.stats.seconds = 0;
+  EXPECT_EQ(planToJson(pa, sc), planToJson(pb, sc));
+}
+
+// alternative_step: a pair's second and later sons wait in the open list
+// behind other contact changes, so fewer of them are expanded.
+TEST(ContactPlanner, APairsLaterSonsWaitInTheOpenList) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
+  auto expandedAlternatives = [&](double step) {
+    PlannerParameters p = plannerParameters(sc);
+    p.alternative_step = step;
+    int count = 0;
+    p.trace = [&](const std::string& line) {
+      count += line.rfind("expand", 0) == 0 && line.find("its pair's son") != std::string::npos;
+    };
+    const PlanningResult r = ContactPlanner(sc, p).plan();
+    EXPECT_TRUE(r.solved()) << "alternative_step " << step << ": " << r.reason;
+    return count;
+  };
+  const int paper = expandedAlternatives(0.0), waiting = expandedAlternatives(1.0);
+  EXPECT_GT(paper, 0);
+  EXPECT_LT(waiting, paper);
+}
+
 TEST(ContactPlanner, InvalidStartIsRefused) {
   test::TempDir dir;
   std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
@@ -207,7 +249,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
       Scenario::load(dir.write("b.yaml", text + "planner: {max_nodes: 77, box_half_sizes: [0.1, 0.2, 0.3], guide_joint_weight: 0.1, "
                                              "depth_weight: 0.02, failure_memory: false, failure_memory_distance: 0.1, "
                                              "failure_memory_angle: 0.5, posture_linear_solver: mumps, "
-                                             "posture_lbfgs_in_kkt: true}\n"));
+                                             "posture_lbfgs_in_kkt: true, alternative_step: 0.05, "
+                                             "posture_stop_at_restoration: false}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -221,11 +264,16 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_TRUE(p.posture.lbfgs_in_kkt);
   EXPECT_FALSE(plannerParameters(plain).posture.lbfgs_in_kkt);  // the planner's default (contact_planner.cpp)
   EXPECT_TRUE(plannerParameters(plain).failure_memory);
+  EXPECT_DOUBLE_EQ(p.alternative_step, 0.05);
+  EXPECT_FALSE(p.posture.stop_at_restoration);
+  EXPECT_TRUE(plannerParameters(plain).posture.stop_at_restoration);  // the planner's default
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
            {"planner: {max_node: 5}\n", "planner.max_node"},
            {"planner: {box_half_sizes: [0.1, -1, 0.3]}\n", "planner.box_half_sizes"},
            {"planner: {depth_weight: -1}\n", "planner.depth_weight"},
+           {"planner: {alternative_step: -0.1}\n", "planner.alternative_step"},
+           {"planner: {posture_stop_at_restoration: often}\n", "planner.posture_stop_at_restoration"},
            {"planner: {guide_joint_weight: 0}\n", "planner.guide_joint_weight"},
            {"planner: {failure_memory_distance: -0.1}\n", "planner.failure_memory_distance"},
            {"planner: {failure_memory: maybe}\n", "planner.failure_memory"},

@@ -479,6 +479,33 @@ TEST(PostureGenerator, ContactOutOfReachIsInfeasibleWithinItsTimeLimit) {  // (d
   EXPECT_LT(res.seconds, o.max_seconds * 1.5);
 }
 
+// stop_at_restoration (the planner's setting): a call that enters Ipopt's
+// restoration phase gives up there, as infeasible; a feasible stance reached
+// without it is still found.
+TEST(PostureGenerator, StopAtRestorationGivesUpEarlierAndKeepsWhatIsReachable) {
+  const Scenario& sc = chair();
+  PostureGeneratorOptions patient, quick;
+  quick.stop_at_restoration = true;
+  PostureGenerator slow_pg(sc.robot, sc.scene, patient), quick_pg(sc.robot, sc.scene, quick);
+  PostureRequest far = wristOnTable(sc);
+  far.floating->volume.polygon = ConvexPolygon({{0.35, -0.1}, {0.4, -0.1}, {0.4, 0.1}, {0.35, 0.1}});
+  const PostureResult a = slow_pg.solve(far), b = quick_pg.solve(far);
+  EXPECT_FALSE(a.success());
+  EXPECT_EQ(b.status, PostureResult::Status::Infeasible) << toString(b.status) << ": " << b.reason;
+  EXPECT_NE(b.reason.find("restoration"), std::string::npos) << b.reason;
+  EXPECT_LT(b.iterations, a.iterations);
+  const PostureResult c = quick_pg.solve(wristOnTable(sc));
+  ASSERT_TRUE(c.success()) << c.reason;
+  std::vector<ContactSpec> stance = sc.start_stance;
+  ContactSpec wrist;
+  wrist.spot = wristOnTable(sc).floating->spot;
+  wrist.surface = wristOnTable(sc).floating->surface;
+  wrist.supporting = false;
+  wrist.placement = c.floating;
+  stance.push_back(wrist);
+  expectValid(sc, c, stance);
+}
+
 TEST(PostureGenerator, OneThighWithTheCenterOfMassFarOutsideFailsOnEquilibrium) {  // (e)
   const Scenario& sc = chair();
   PostureGenerator pg(sc.robot, sc.scene);

@@ -101,10 +101,15 @@ class PostureTNLP : public Ipopt::TNLP {
     for (Ipopt::Index i = 0; i < n; ++i) values[i] = std::max(obj_factor, 1e-3) * hdiag_[i];
     return true;
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+  bool intermediate_callback(Ipopt::AlgorithmMode mode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Index, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+                             Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
+                             Ipopt::IpoptCalculatedQuantities*) override {
     iterations = iter;
+    if (stop_at_restoration && mode == Ipopt::RestorationPhaseMode) {
+      entered_restoration = true;
+      return false;  // Ipopt stops with USER_REQUESTED_STOP
+    }
     return true;
   }
   void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
@@ -116,6 +121,8 @@ class PostureTNLP : public Ipopt::TNLP {
   }
 
   Ipopt::SolverReturn final_status = Ipopt::INTERNAL_ERROR;
+  bool stop_at_restoration = false;
+  bool entered_restoration = false;
   Eigen::VectorXd x_final;
   double final_cost = 0;
   int iterations = 0;
@@ -221,6 +228,7 @@ PostureResult PostureGenerator::solve(const PostureRequest& request) {
                       : opt_.hessian == "analytic" ? PostureTNLP::Hessian::Analytic
                                                    : PostureTNLP::Hessian::Diagonal;
     ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0, kind);
+    nlp->stop_at_restoration = opt_.stop_at_restoration;
     const double budget = opt_.max_seconds - elapsed();
     if (budget <= 0) {
       res.status = PostureResult::Status::TimeLimit;
@@ -247,6 +255,12 @@ PostureResult PostureGenerator::solve(const PostureRequest& request) {
       case ::Ipopt::CPUTIME_EXCEEDED:
         res.status = PostureResult::Status::TimeLimit;
         res.reason = "no feasible posture within the time limit";
+        break;
+      case ::Ipopt::USER_REQUESTED_STOP:
+        res.status = PostureResult::Status::Infeasible;
+        res.reason = nlp->entered_restoration
+                         ? "no step toward feasibility from the initial guess (the solver entered its restoration phase)"
+                         : "the solver was stopped";
         break;
       case ::Ipopt::LOCAL_INFEASIBILITY:
         res.status = PostureResult::Status::Infeasible;

@@ -40,6 +40,9 @@ PlannerParameters::PlannerParameters() {
   // posture (GuideAuthor.SitDownIsPlanned...LeaningLessOrMore) wandered off
   // the chair for 300 nodes. A scenario may choose (posture_lbfgs_in_kkt).
   posture.lbfgs_in_kkt = false;
+  // A call that enters Ipopt's restoration phase gives up (see the option):
+  // failures are most of the search's time.
+  posture.stop_at_restoration = true;
 }
 
 namespace {
@@ -95,6 +98,7 @@ struct ContactPlanner::Impl {
     int parent = -1;
     Change change = Change::Root;
     int generator = -1;                   // the pair generator that made it (lazy sons)
+    int alternative = 0;                  // sons its pair generator made before it
     int depth = 0;                        // contact changes from the start (set by addNode)
     int changed_spot = -1;                // the spot of the contact added or removed from its parent
     bool dead = false;                    // no plan can be exported through it (exportPlan): not expanded
@@ -105,6 +109,7 @@ struct ContactPlanner::Impl {
     std::vector<std::pair<double, SearchVolume>> volumes;  // inherited key, volume
     int samples_left = 0;
     bool first = true;  // its next candidate is the first (the whole surface)
+    int sons = 0;       // sons it made (nodes in the tree)
   };
   struct Entry {
     double key;
@@ -223,7 +228,9 @@ struct ContactPlanner::Impl {
     const Eigen::Vector3d w = kin.linkPose(sc.goal.link).translation();
     std::string line = "expand #" + std::to_string(ni) + " depth " + std::to_string(n.depth) + " key " +
                        std::to_string(n.key) + " goal link (" + std::to_string(w.x()).substr(0, 6) + ", " +
-                       std::to_string(w.y()).substr(0, 6) + ", " + std::to_string(w.z()).substr(0, 6) + "):";
+                       std::to_string(w.y()).substr(0, 6) + ", " + std::to_string(w.z()).substr(0, 6) + ")" +
+                       (n.alternative > 0 ? ", its pair's son " + std::to_string(n.alternative + 1) : std::string()) +
+                       ":";
     char buf[64];
     for (const auto& c : n.contacts) {
       std::snprintf(buf, sizeof buf, "(%.2f,%.2f)", c.placement.x, c.placement.y);
@@ -261,7 +268,9 @@ struct ContactPlanner::Impl {
     if (goal_node < 0 && meetsGoal(nodes[id])) goal_node = id;
     // The open list's order: f_T, plus (when set) a cost per contact change
     // from the start, which lifts plateaus of equal f_T (weighted A*).
-    open.push({nodes[id].key + p.depth_weight * nodes[id].depth, order++, id});
+    open.push({nodes[id].key + p.depth_weight * nodes[id].depth +
+                   p.potential_k * p.alternative_step * nodes[id].alternative,
+               order++, id});
     if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) stats.best_potential = nodes[id].key;
     return id;
   }
@@ -432,10 +441,13 @@ struct ContactPlanner::Impl {
     son.change = Change::Added;
     son.changed_spot = g.spot;
     son.generator = gi;
+    son.alternative = gens[gi].sons;
     son.key = key;  // also orders the parts of its volume
     if (p.optimized_candidates)
       for (auto& part : subtractBox(cand.volume, res.floating, p.box)) gens[gi].volumes.push_back({son.key, part});
-    return addNode(son, true);
+    const int id = addNode(son, true);
+    if (id >= 0) ++gens[gi].sons;
+    return id;
   }
 
   // The next son of a pair generator, or -1 when it has none left: its
@@ -661,6 +673,7 @@ struct ContactPlanner::Impl {
     if (valid(removed)) return removed;
     PostureGeneratorOptions patient = p.posture;
     patient.max_iterations = std::max(300, p.posture.max_iterations);
+    patient.stop_at_restoration = false;  // the last resort: an answer whenever there is one
     PostureGenerator generator(sc.robot, sc.scene, patient);
     return solve(added, &generator);
   }

@@ -31,7 +31,13 @@ struct PlannerParameters {
   double smoothing_tolerance = 0.05;   // corner blends of the guide
   double guide_joint_weight = 1.0;     // weight of the joints in |P - Q|^2 (the base's is 1)
   double depth_weight = 0.0;           // added to a node's key per contact change from the start (0: the paper)
-  BoxHalfSizes box;                    // subtracted around each candidate
+  // m along the guide: a pair's n-th son waits in the open list as if its
+  // f_T were k * alternative_step * (n - 1) higher (0: the paper). See
+  // ContactPlanner::Impl::addNode.
+  double alternative_step = 0.02;
+  // Subtracted around each candidate: a contact this close to one already
+  // tried is not a new one (20 cm by 20 cm, 40 degrees; see README "Search").
+  BoxHalfSizes box{0.10, 0.10, 0.35};
   double duplicate_distance = 0.05;    // m: sons this close to a node (same contacts) are dropped
   double duplicate_angle = 0.35;       // rad
   int max_contacts = 6;                // no stance with more contacts

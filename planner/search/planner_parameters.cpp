@@ -6,9 +6,9 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   PlannerParameters p;
   if (!sc.planner_section) return p;
   const YamlField& f = *sc.planner_section;
-  f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
+  f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
-               "posture_lbfgs_in_kkt",
+               "posture_lbfgs_in_kkt", "posture_stop_at_restoration",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -30,6 +30,10 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     p.depth_weight = f["depth_weight"].number();
     if (!(p.depth_weight >= 0)) f["depth_weight"].fail("a number >= 0");
   }
+  if (f.has("alternative_step")) {
+    p.alternative_step = f["alternative_step"].number();
+    if (!(p.alternative_step >= 0)) f["alternative_step"].fail("a number >= 0 (m along the guide)");
+  }
   positive("duplicate_distance", p.duplicate_distance);
   positive("duplicate_angle", p.duplicate_angle);
   positive("failure_memory_distance", p.failure_memory_distance);
@@ -48,6 +52,8 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     p.posture.linear_solver = v;
   }
   if (f.has("posture_lbfgs_in_kkt")) p.posture.lbfgs_in_kkt = f["posture_lbfgs_in_kkt"].boolean();
+  if (f.has("posture_stop_at_restoration"))
+    p.posture.stop_at_restoration = f["posture_stop_at_restoration"].boolean();
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
     if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
