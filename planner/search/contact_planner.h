@@ -32,8 +32,11 @@ struct PlannerParameters {
   double guide_joint_weight = 1.0;     // weight of the joints in |P - Q|^2 (the base's is 1)
   double depth_weight = 0.0;           // added to a node's key per contact change from the start (0: the paper)
   // m along the guide: a pair's n-th son waits in the open list as if its
-  // f_T were k * alternative_step * (n - 1) higher (0: the paper). See
-  // ContactPlanner::Impl::addNode.
+  // f_T were k * alternative_step * (n - 1) higher (0: the paper). Where
+  // the search must cross a rise of f_T (a side step raises it while the
+  // weight goes onto the trailing foot), a foot's pair otherwise supplies
+  // placements without end, each a little worse than the last, and best
+  // first expands all of them below the rise (README "Contact planner").
   double alternative_step = 0.02;
   // Subtracted around each candidate: a contact this close to one already
   // tried is not a new one (20 cm by 20 cm, 40 degrees; see README "Search").
