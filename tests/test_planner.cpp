@@ -159,8 +159,9 @@ TEST(ContactPlanner, CallsSolvedAheadLeaveTheTreeAsItWas) {
   EXPECT_EQ(a.stats.nodes_expanded, b.stats.nodes_expanded);
   EXPECT_EQ(a.stats.posture_calls, b.stats.posture_calls);
   EXPECT_EQ(a.stats.posture_failures, b.stats.posture_failures);
-  EXPECT_EQ(a.stats.calls_ahead_unused, 0);
-  EXPECT_GT(b.stats.calls_ahead_unused, 0);  // candidates were solved ahead, and given back
+  // Two at a time solves candidates ahead that go back to their pair (one
+  // thread too may leave a batch's last results when the goal is met).
+  EXPECT_GT(b.stats.calls_ahead_unused, a.stats.calls_ahead_unused);
   Plan pa = a.plan, pb = b.plan;
   pa.stats.seconds = pb.stats.seconds = 0;
   EXPECT_EQ(planToJson(pa, sc), planToJson(pb, sc));

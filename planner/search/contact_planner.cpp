@@ -318,6 +318,15 @@ struct ContactPlanner::Impl {
     return b;
   }
 
+  // A batch's result that the search does not take (solved ahead, its turn
+  // never came): counted apart from the posture calls.
+  void notUsed(const Batch& b, std::size_t i) {
+    if (!b.ran[i]) return;
+    --stats.posture_calls;
+    if (!b.results[i].success()) --stats.posture_failures;
+    ++stats.calls_ahead_unused;
+  }
+
   void traceCall(const std::string& what, const PostureResult& res) const {
     if (p.trace)
       p.trace("  " + what + ": " + toString(res.status) + " (" + std::to_string(res.iterations) + " it, " +
@@ -479,12 +488,7 @@ struct ContactPlanner::Impl {
         std::vector<std::pair<double, SearchVolume>> v = left[k - 1];
         v.insert(v.end(), gens[gi].volumes.begin() + static_cast<long>(left.back().size()), gens[gi].volumes.end());
         gens[gi].volumes = std::move(v);
-        for (std::size_t j = k; j < cands.size(); ++j)
-          if (b.ran[j]) {
-            --stats.posture_calls;
-            if (!b.results[j].success()) --stats.posture_failures;
-            ++stats.calls_ahead_unused;
-          }
+        for (std::size_t j = k; j < cands.size(); ++j) notUsed(b, j);
       };
       for (std::size_t k = 0; k < cands.size(); ++k) {
         if (k > 0 && (!budgetLeft() || goal_node >= 0)) {
@@ -624,26 +628,32 @@ struct ContactPlanner::Impl {
       else before.reset();
     }
     const Batch b = solveAll(requests);
+    std::vector<char> used(requests.size(), 0);
     for (std::size_t k = 0; k < n_removals && goal_node < 0; ++k)
-      if (b.ran[k]) acceptRemoval(ni, removed[k], requests[k], b.results[k]);
+      if (b.ran[k]) acceptRemoval(ni, removed[k], requests[k], b.results[k]), used[k] = 1;
     if (budgetLeft() && goal_node < 0) {
       for (std::size_t j = 0; j < with_candidate.size() && goal_node < 0; ++j) {
         const std::size_t r = n_removals + j;
         if (!b.ran[r]) break;  // cancelled, or out of posture calls
         const int k = with_candidate[j];
+        used[r] = 1;
         if (acceptCandidate(pairs[k], cands[k], b.results[r]) < 0 && b.results[r].success()) nextSon(pairs[k]);
       }
     }
-    if (selected_from < 0) return;
     if (before) {
       const std::size_t r = requests.size() - 1;
-      if (!(budgetLeft() && goal_node < 0 && b.ran[r])) {
+      if (budgetLeft() && goal_node < 0 && b.ran[r]) {
+        used[r] = 1;
+        if (acceptCandidate(selected_from, next, b.results[r]) < 0) nextSon(selected_from);
+      } else {
         gens[selected_from] = *before;
-        return;
       }
-      if (acceptCandidate(selected_from, next, b.results[r]) >= 0) return;
+    } else if (selected_from >= 0) {
+      nextSon(selected_from);
     }
-    nextSon(selected_from);
+    // Results the search ended before taking: solved ahead, not used.
+    for (std::size_t r = 0; r < requests.size(); ++r)
+      if (!used[r]) notUsed(b, r);
   }
 
   // A witness for the stance `contacts` between a removal (witness `removed`)
