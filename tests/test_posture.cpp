@@ -67,6 +67,17 @@ PostureRequest wristOnTable(const Scenario& sc) {
   return r;
 }
 
+// The floating contact of a request, placed where a result put it: geometric
+// only (being added), as the next stance of a search holds it.
+ContactSpec placedContact(const PostureRequest& r, const PostureResult& res) {
+  ContactSpec c;
+  c.spot = r.floating->spot;
+  c.surface = r.floating->surface;
+  c.supporting = false;
+  c.placement = res.floating;
+  return c;
+}
+
 // Central differences of the problem's cost at x, variable by variable.
 Eigen::VectorXd numericCostGradient(PostureProblem& p, const Eigen::VectorXd& x) {
   Eigen::VectorXd g(x.size());
@@ -433,12 +444,7 @@ TEST(PostureGenerator, LeftWristAnywhereOnTheTable) {  // (c)
   ASSERT_TRUE(res.success()) << toString(res.status) << ": " << res.reason;
   EXPECT_TRUE(sc.scene->surfaces()[r.floating->surface].polygon.contains({res.floating.x, res.floating.y}));
   std::vector<ContactSpec> stance = sc.start_stance;
-  ContactSpec wrist;
-  wrist.spot = r.floating->spot;
-  wrist.surface = r.floating->surface;
-  wrist.supporting = false;  // being added: geometric only
-  wrist.placement = res.floating;
-  stance.push_back(wrist);
+  stance.push_back(placedContact(r, res));
   expectValid(sc, res, stance);
 }
 
@@ -451,14 +457,9 @@ TEST(PostureGenerator, AFloatingContactsPlacementIsAcceptedAsAFixedContact) {
   r.floating->volume.polygon = ConvexPolygon({{-0.4, -0.6}, {-0.3, -0.6}, {-0.3, 0.6}, {-0.4, 0.6}});  // the near edge
   const PostureResult a = pg.solve(r);
   ASSERT_TRUE(a.success()) << a.reason;
-  ContactSpec wrist;
-  wrist.spot = r.floating->spot;
-  wrist.surface = r.floating->surface;
-  wrist.supporting = false;
-  wrist.placement = a.floating;
   PostureRequest next;
   next.contacts = sc.start_stance;
-  next.contacts.push_back(wrist);
+  next.contacts.push_back(placedContact(r, a));
   next.initial_guess = a.configuration;
   const PostureResult b = pg.solve(next);
   EXPECT_NE(b.status, PostureResult::Status::BadInput) << b.reason;
@@ -494,15 +495,11 @@ TEST(PostureGenerator, StopAtRestorationGivesUpEarlierAndKeepsWhatIsReachable) {
   EXPECT_EQ(b.status, PostureResult::Status::Infeasible) << toString(b.status) << ": " << b.reason;
   EXPECT_NE(b.reason.find("restoration"), std::string::npos) << b.reason;
   EXPECT_LT(b.iterations, a.iterations);
-  const PostureResult c = quick_pg.solve(wristOnTable(sc));
+  const PostureRequest anywhere = wristOnTable(sc);
+  const PostureResult c = quick_pg.solve(anywhere);
   ASSERT_TRUE(c.success()) << c.reason;
   std::vector<ContactSpec> stance = sc.start_stance;
-  ContactSpec wrist;
-  wrist.spot = wristOnTable(sc).floating->spot;
-  wrist.surface = wristOnTable(sc).floating->surface;
-  wrist.supporting = false;
-  wrist.placement = c.floating;
-  stance.push_back(wrist);
+  stance.push_back(placedContact(anywhere, c));
   expectValid(sc, c, stance);
 }
 

@@ -39,7 +39,7 @@ struct PlannerParameters {
   // first expands all of them below the rise (README "Contact planner").
   double alternative_step = 0.02;
   // Subtracted around each candidate: a contact this close to one already
-  // tried is not a new one (20 cm by 20 cm, 40 degrees; see README "Search").
+  // tried is not a new one (20 cm by 20 cm, 40 degrees; see README "The chair scenario: solved").
   BoxHalfSizes box{0.10, 0.10, 0.35};
   double duplicate_distance = 0.05;    // m: sons this close to a node (same contacts) are dropped
   double duplicate_angle = 0.35;       // rad
