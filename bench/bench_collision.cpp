@@ -1,5 +1,7 @@
 // Signed distances of every robot-environment and self-collision pair of the
-// chair scenario (FCL), with and without gradients (Simbody Jacobians).
+// chair scenario, with and without gradients (Simbody Jacobians), by either
+// engine: FCL's GJK (the independent check's) and convex::separation (the
+// posture generator's).
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -31,8 +33,8 @@ std::vector<Configuration> configurations() {
   return qs;
 }
 
-void run(benchmark::State& st, const DistanceOptions& opt) {
-  CollisionModel cm(chair().robot, chair().scene);
+void run(benchmark::State& st, const DistanceOptions& opt, DistanceEngine engine = DistanceEngine::Fcl) {
+  CollisionModel cm(chair().robot, chair().scene, engine);
   Kinematics k(chair().robot);
   const auto qs = configurations();
   std::size_t i = 0, pairs = 0;
@@ -63,6 +65,24 @@ void BM_PairsWithin10cmWithGradients(benchmark::State& st) {
   run(st, opt);
 }
 BENCHMARK(BM_PairsWithin10cmWithGradients)->Unit(benchmark::kMicrosecond);
+
+void BM_AllPairsConvex(benchmark::State& st) { run(st, {}, DistanceEngine::Convex); }
+BENCHMARK(BM_AllPairsConvex)->Unit(benchmark::kMicrosecond);
+
+void BM_AllPairsWithGradientsConvex(benchmark::State& st) {
+  DistanceOptions opt;
+  opt.gradients = true;
+  run(st, opt, DistanceEngine::Convex);
+}
+BENCHMARK(BM_AllPairsWithGradientsConvex)->Unit(benchmark::kMicrosecond);
+
+void BM_PairsWithin10cmWithGradientsConvex(benchmark::State& st) {
+  DistanceOptions opt;
+  opt.gradients = true;
+  opt.cutoff = 0.10;
+  run(st, opt, DistanceEngine::Convex);
+}
+BENCHMARK(BM_PairsWithin10cmWithGradientsConvex)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -5,6 +5,8 @@
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
 
+#include "planner/collision/convex_distance.h"
+
 namespace acyclic {
 
 namespace {
@@ -93,21 +95,29 @@ struct CollisionModel::Geometry {
   // robot[link][shape], obstacles[i]
   std::vector<std::vector<std::shared_ptr<fcl::CollisionGeometryd>>> robot;
   std::vector<std::vector<double>> robot_radius;
+  std::vector<std::vector<convex::Primitive>> robot_primitive;  // the Convex engine's
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> obstacles;
+  std::vector<convex::Primitive> obstacle_primitive;
   std::vector<fcl::AABBd> obstacle_aabb;  // world
 };
 
-CollisionModel::CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
-    : robot_(std::move(robot)), scene_(std::move(scene)), geom_(std::make_unique<Geometry>()) {
+CollisionModel::CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                               DistanceEngine engine)
+    : robot_(std::move(robot)), scene_(std::move(scene)), engine_(engine), geom_(std::make_unique<Geometry>()) {
   const auto& links = robot_->links();
   geom_->robot.resize(links.size());
   geom_->robot_radius.resize(links.size());
+  geom_->robot_primitive.resize(links.size());
   for (const auto& l : links)
     for (const auto& s : l.shapes) {
       geom_->robot[l.index].push_back(makeGeometry(s));
       geom_->robot_radius[l.index].push_back(boundingRadius(s));
+      geom_->robot_primitive[l.index].push_back(convex::primitiveOf(s));
     }
-  for (const auto& o : scene_->obstacles()) geom_->obstacles.push_back(makeGeometry(o.shape));
+  for (const auto& o : scene_->obstacles()) {
+    geom_->obstacles.push_back(makeGeometry(o.shape));
+    geom_->obstacle_primitive.push_back(convex::primitiveOf(o.shape));
+  }
   for (std::size_t i = 0; i < scene_->obstacles().size(); ++i) {
     // World AABB: transform the local AABB's corners.
     const auto& local = geom_->obstacles[i]->aabb_local;
@@ -187,16 +197,29 @@ PairDistance CollisionModel::pairDistance(const Kinematics& kin, int i, bool gra
   const Eigen::Isometry3d Ta = kin.linkPose(p.link_a) * links[p.link_a].shapes[p.shape_a].pose;
   Eigen::Isometry3d Tb;
   const fcl::CollisionGeometryd* gb;
+  const convex::Primitive* cb;
   if (p.kind == CollisionPair::Kind::RobotEnvironment) {
     gb = geom_->obstacles[p.obstacle].get();
+    cb = &geom_->obstacle_primitive[p.obstacle];
     Tb = scene_->obstacles()[p.obstacle].shape.pose;
   } else {
     gb = geom_->robot[p.link_b][p.shape_b].get();
+    cb = &geom_->robot_primitive[p.link_b][p.shape_b];
     Tb = kin.linkPose(p.link_b) * links[p.link_b].shapes[p.shape_b].pose;
   }
   PairDistance d;
   d.pair = i;
-  d.distance = fclDistance(geom_->robot[p.link_a][p.shape_a].get(), Ta, gb, Tb, &d.point_a, &d.point_b);
+  bool found = false;
+  if (engine_ == DistanceEngine::Convex) {
+    const convex::Separation s = convex::separation(geom_->robot_primitive[p.link_a][p.shape_a], Ta, *cb, Tb);
+    if (!s.cores_overlap) {
+      d.distance = s.distance;
+      d.point_a = s.point_a;
+      d.point_b = s.point_b;
+      found = true;
+    }
+  }
+  if (!found) d.distance = fclDistance(geom_->robot[p.link_a][p.shape_a].get(), Ta, gb, Tb, &d.point_a, &d.point_b);
   if (gradient) {
     // d = n . (pb - pa) with n = (pb - pa) / d for either sign of d, so
     // grad d = n^T (J_b(pb) - J_a(pa)). At contact (d ~ 0) the witness

@@ -41,15 +41,25 @@ double shapeDistance(const CollisionShape& a, const Eigen::Isometry3d& Ta, const
                      const Eigen::Isometry3d& Tb, Eigen::Vector3d* point_a = nullptr,
                      Eigen::Vector3d* point_b = nullptr);
 
+// How a pair's distance is computed. Fcl: FCL's GJK (libccd) for separated
+// shapes, its collide() for the depth of penetrating ones; the independent
+// checks use it. Convex: convex::separation (convex_distance.h) for
+// separated shapes, several times faster, and FCL when the shapes' cores
+// overlap; the posture generator uses it, so that the check's distances come
+// from other code than the generator's.
+enum class DistanceEngine { Fcl, Convex };
+
 class CollisionModel {
  public:
-  CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene);
+  CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                 DistanceEngine engine = DistanceEngine::Fcl);
   ~CollisionModel();
 
   const std::vector<CollisionPair>& pairs() const { return pairs_; }
   std::string describe(int pair) const;  // "RLEG_LINK2/capsule_thigh ~ chair_seat"
   int numRobotEnvironmentPairs() const { return n_env_; }
   int numSelfPairs() const { return static_cast<int>(pairs_.size()) - n_env_; }
+  DistanceEngine engine() const { return engine_; }
 
   // Distances of every pair (within the cutoff) at the kinematics' configuration.
   // Thread-safe: the model is read-only; use one Kinematics per thread.
@@ -65,6 +75,7 @@ class CollisionModel {
   std::shared_ptr<const Scene> scene_;
   std::vector<CollisionPair> pairs_;
   int n_env_ = 0;
+  DistanceEngine engine_;
   double lowerBound(const Kinematics& kin, int pair) const;
   std::unique_ptr<Geometry> geom_;
 };
