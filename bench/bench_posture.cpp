@@ -111,6 +111,8 @@ int main(int argc, char** argv) {
   app.add_option("--stop-at-restoration", opt.stop_at_restoration,
                  "give up when Ipopt enters its restoration phase (the planner's setting)")
       ->capture_default_str();
+  app.add_option("--mu-oracle", opt.mu_oracle, "Ipopt's barrier-parameter oracle: quality-function, probing or loqo")
+      ->capture_default_str();
   app.add_option("--ipopt", opt.ipopt_options, "further Ipopt option name=value (repeatable)");
   CLI11_PARSE(app, argc, argv);
   const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml");

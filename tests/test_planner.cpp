@@ -251,7 +251,7 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
                                              "depth_weight: 0.02, failure_memory: false, failure_memory_distance: 0.1, "
                                              "failure_memory_angle: 0.5, posture_linear_solver: mumps, "
                                              "posture_lbfgs_in_kkt: true, alternative_step: 0.05, "
-                                             "posture_stop_at_restoration: false}\n"));
+                                             "posture_stop_at_restoration: false, posture_mu_oracle: probing}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -268,6 +268,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_DOUBLE_EQ(p.alternative_step, 0.05);
   EXPECT_FALSE(p.posture.stop_at_restoration);
   EXPECT_TRUE(plannerParameters(plain).posture.stop_at_restoration);  // the planner's default
+  EXPECT_EQ(p.posture.mu_oracle, "probing");
+  EXPECT_EQ(plannerParameters(plain).posture.mu_oracle, "quality-function");
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
            {"planner: {max_node: 5}\n", "planner.max_node"},
@@ -279,7 +281,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {failure_memory_distance: -0.1}\n", "planner.failure_memory_distance"},
            {"planner: {failure_memory: maybe}\n", "planner.failure_memory"},
            {"planner: {posture_linear_solver: pardiso}\n", "planner.posture_linear_solver"},
-           {"planner: {posture_lbfgs_in_kkt: sometimes}\n", "planner.posture_lbfgs_in_kkt"}}) {
+           {"planner: {posture_lbfgs_in_kkt: sometimes}\n", "planner.posture_lbfgs_in_kkt"},
+           {"planner: {posture_mu_oracle: fast}\n", "planner.posture_mu_oracle"}}) {
     const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
     try {
       plannerParameters(sc);

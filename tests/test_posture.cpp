@@ -400,7 +400,7 @@ TEST(PostureGenerator, EveryLinearSolverSolvesTheSameStance) {
   }
 }
 
-TEST(PostureGenerator, LdlRefusesAFullHessianBlock) {
+TEST(PostureGenerator, MisuseIsRefusedAtConstruction) {
   // The LDL^T needs a diagonal Hessian block; a full one is misuse, said at
   // construction rather than as a failed solve.
   const Scenario& sc = chair();
@@ -411,6 +411,11 @@ TEST(PostureGenerator, LdlRefusesAFullHessianBlock) {
   EXPECT_NO_THROW(PostureGenerator(sc.robot, sc.scene, o));
   o.linear_solver = "pardiso";
   EXPECT_THROW(PostureGenerator(sc.robot, sc.scene, o), std::invalid_argument);
+  PostureGeneratorOptions m;
+  m.mu_oracle = "probing";
+  EXPECT_NO_THROW(PostureGenerator(sc.robot, sc.scene, m));
+  m.mu_oracle = "fast";
+  EXPECT_THROW(PostureGenerator(sc.robot, sc.scene, m), std::invalid_argument);
 }
 
 TEST(PostureGenerator, HalfSittingDoubleSupport) {  // (b)

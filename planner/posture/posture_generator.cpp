@@ -175,6 +175,9 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
     throw std::invalid_argument("PostureGeneratorOptions::linear_solver: expected ldl or mumps");
   }
   o->SetStringValue("mu_strategy", "adaptive");
+  if (opt_.mu_oracle != "quality-function" && opt_.mu_oracle != "probing" && opt_.mu_oracle != "loqo")
+    throw std::invalid_argument("PostureGeneratorOptions::mu_oracle: expected quality-function, probing or loqo");
+  o->SetStringValue("mu_oracle", opt_.mu_oracle);
   o->SetNumericValue("tol", opt_.tolerance);
   o->SetNumericValue("constr_viol_tol", opt_.tolerance);
   // A witness posture needs feasibility, not a polished optimum: stop once

@@ -49,6 +49,12 @@ struct PostureGeneratorOptions {
   // diagonal but for L-BFGS's rows: hessian "lbfgs" or "diagonal", not
   // "analytic".
   std::string linear_solver = "ldl";
+  // How Ipopt's adaptive barrier parameter is chosen at each iteration
+  // (Ipopt's mu_oracle): "quality-function" (Ipopt's default) or "probing"
+  // (Mehrotra's affine-scaling probe: one more back-solve per iteration,
+  // cheap with "ldl"), or "loqo". See README "Posture generator" for the
+  // measurements behind the default.
+  std::string mu_oracle = "quality-function";
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).
   std::vector<std::string> ipopt_options;

@@ -8,7 +8,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   const YamlField& f = *sc.planner_section;
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
-               "posture_lbfgs_in_kkt", "posture_stop_at_restoration",
+               "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -54,6 +54,11 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   if (f.has("posture_lbfgs_in_kkt")) p.posture.lbfgs_in_kkt = f["posture_lbfgs_in_kkt"].boolean();
   if (f.has("posture_stop_at_restoration"))
     p.posture.stop_at_restoration = f["posture_stop_at_restoration"].boolean();
+  if (f.has("posture_mu_oracle")) {
+    const std::string v = f["posture_mu_oracle"].string();
+    if (v != "quality-function" && v != "probing" && v != "loqo") f["posture_mu_oracle"].fail("quality-function, probing or loqo");
+    p.posture.mu_oracle = v;
+  }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
     if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
