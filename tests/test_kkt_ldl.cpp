@@ -4,6 +4,7 @@
 // patterns reported.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include <Eigen/Dense>
@@ -259,3 +260,44 @@ TEST(KktLdl, RefusesAPatternThatIsNotBipartite) {
 }
 
 }  // namespace
+
+// factor() keeps what it found of a pattern for the next factorization of the
+// same pattern (planner/posture/kkt_ldl.cpp, Program). It must notice any
+// other pattern, even of the same size: here the same matrix with its
+// triplets in another order (each value then comes from another place), and
+// the same with one entry moved to another column. Each is solved as a fresh
+// factorization would, and the first, factorized again, gives the same
+// factors bit for bit.
+TEST(KktLdl, APatternsKeptAnalysisServesOnlyThatPattern) {
+  const Kkt a = makeKkt(40, 10, 50, 31);
+  Kkt shuffled = a;
+  std::mt19937 rng(7);
+  std::vector<int> order(a.a.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::shuffle(order.begin(), order.end(), rng);
+  for (std::size_t i = 0; i < order.size(); ++i)
+    shuffled.irn[i] = a.irn[order[i]], shuffled.jcn[i] = a.jcn[order[i]], shuffled.a[i] = a.a[order[i]];
+  // One entry of an inequality row moved to another variable's column.
+  Kkt other = a;
+  const int d0 = 40 + 50 + 10;  // first inequality row (0-based)
+  std::size_t moved = 0;
+  while (!(other.irn[moved] - 1 >= d0 && other.jcn[moved] - 1 < 40)) ++moved;
+  const int row = other.irn[moved] - 1, from = other.jcn[moved] - 1, to = (from + 7) % 40;
+  other.jcn[moved] = to + 1;
+  other.dense(row, from) -= other.a[moved], other.dense(from, row) -= other.a[moved];
+  other.dense(row, to) += other.a[moved], other.dense(to, row) += other.a[moved];
+  ASSERT_EQ(a.n, other.n);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(a.n, -1, 2);
+  const Factors first = factorize(a);
+  for (const Kkt* k : std::vector<const Kkt*>{&a, &shuffled, &other, &a}) {
+    const Factors f = factorize(*k);
+    ASSERT_EQ(f.status, 0);
+    const Eigen::VectorXd x = solveWith(f, b);
+    EXPECT_LT((k->dense * x - b).norm(), 1e-9 * b.norm());
+    if (k == &a) {
+      EXPECT_EQ(f.Li, first.Li);
+      EXPECT_EQ(f.Lx, first.Lx);
+      EXPECT_EQ(f.D, first.D);
+    }
+  }
+}

@@ -10,6 +10,8 @@ namespace acyclic::kkt {
 
 namespace {
 
+#define ACYCLIC_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+
 // Relative size under which a pivot counts as zero: a few hundred roundings.
 constexpr double kZeroPivot = 1e-13;
 // A trailing block smaller than this is left to the sparse elimination.
@@ -17,11 +19,46 @@ constexpr int kMinDense = 8;
 // A column with this many rows in the trailing block updates it densely.
 constexpr int kHeavyColumn = 12;
 
-// Scratch reused across calls on one thread (never state between calls).
+// What a factorization does that depends on the pattern only: found by the
+// first factorization of a pattern and replayed by the next ones (Ipopt
+// factorizes the same pattern at every iteration of a solve), so that the
+// numeric pass walks flat lists instead of the elimination tree. The
+// arithmetic, and its order, is the same either way.
+struct Program {
+  // The pattern it was made for (compared whole: no hash to collide).
+  int n = -1, nz = -1;
+  std::vector<int> irn, jcn, perm;
+  // The permuted upper triangle (permutedUpper).
+  std::vector<int> colptr, rows, src;
+  int t = 0, m = 0;  // the dense trailing block's first column and size
+  // Row k of L left of the block: steps [row_step[k], row_step[k + 1]), in
+  // elimination order. Step: column `col` of L gets row k at `write`, after
+  // updating the working row through its entries [Lp[col], `update_end`),
+  // whose rows are consecutive from `first_row` when that is >= 0 (the
+  // nearly full columns of the configuration: a contiguous, vectorized
+  // update instead of a scatter).
+  struct Step {
+    int col, write, update_end, first_row;
+  };
+  std::vector<int> row_step;
+  std::vector<Step> steps;
+  // Columns left of the block: where their rows inside the block start in
+  // Li/Lx, and whether they update it densely (heavy) or entry by entry.
+  std::vector<int> block_begin;
+  std::vector<char> heavy;
+  int heavy_pos = 0, heavy_neg = 0;  // unknown until D's signs: counted per factorization
+  bool matches(int n_, int nz_, const int* irn_, const int* jcn_, const int* perm_) const {
+    return n == n_ && nz == nz_ && std::equal(irn.begin(), irn.end(), irn_) &&
+           std::equal(jcn.begin(), jcn.end(), jcn_) && std::equal(perm.begin(), perm.end(), perm_);
+  }
+};
+
+// Scratch reused across calls on one thread (never state between calls but
+// the program, which is checked against the pattern before each use).
 struct Scratch {
-  std::vector<int> pinv, colptr, rows, src;  // the permuted upper triangle (permutedUpper)
+  Program program;
+  std::vector<int> pinv;                     // permutedUpper's inverse permutation
   std::vector<int> next;                     // permutedUpper's fill positions
-  std::vector<int> work;                     // factor's flag, filled and pattern
   std::vector<double> y;                     // factor's row being eliminated
   std::vector<double> schur, scale;          // the dense trailing block, its pivots' scales
   std::vector<std::pair<int, int>> heavy;    // columns whose block rows are gathered densely, where those start
@@ -153,25 +190,100 @@ long analyse(int n, int nz, const int* irn, const int* jcn, int* perm, int* pare
   return total;
 }
 
-int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const int* perm, const int* parent,
-           const int* colcount, int* Lp, int* Li, double* Lx, double* D, int* negative) {
-  Scratch& s = scratch();
-  std::vector<int>& pinv = s.pinv;
+namespace {
+
+// The program of a pattern: the original up-looking traversal (the nonzero
+// pattern of each row of L as paths up the elimination tree from the
+// entries of its column of the upper triangle, as far as the dense block),
+// recorded instead of computed on.
+void makeProgram(Program& pr, int n, int nz, const int* irn, const int* jcn, const int* perm, const int* parent,
+                 const int* colcount) {
+  pr.n = n, pr.nz = nz;
+  pr.irn.assign(irn, irn + nz);
+  pr.jcn.assign(jcn, jcn + nz);
+  pr.perm.assign(perm, perm + n);
+  std::vector<int>& pinv = scratch().pinv;
   pinv.resize(n);
   for (int i = 0; i < n; ++i) pinv[perm[i]] = i;
-  std::vector<int>& colptr = s.colptr;
-  std::vector<int>& rows = s.rows;
-  std::vector<int>& src = s.src;
-  permutedUpper(n, nz, irn, jcn, pinv.data(), colptr, rows, src);
+  permutedUpper(n, nz, irn, jcn, pinv.data(), pr.colptr, pr.rows, pr.src);
+  const int t = denseStart(n, [colcount](int c) { return colcount[c]; });
+  pr.t = t, pr.m = n - t;
+  std::vector<int> Lp(n + 1);
+  Lp[0] = 0;
+  for (int c = 0; c < n; ++c) Lp[c + 1] = Lp[c] + colcount[c];
+  std::vector<int> flag(n, -1), filled(n, 0), above(n, 0), pattern(n);
+  std::vector<int> Li(Lp[n]);  // the rows of L's entries, as factor() writes them
+  pr.row_step.assign(n + 1, 0);
+  pr.steps.clear();
+  for (int k = 0; k < n; ++k) {
+    int top = n;
+    flag[k] = k;
+    for (int p = pr.colptr[k]; p < pr.colptr[k + 1]; ++p) {
+      int i = pr.rows[p];
+      if (i >= t) continue;
+      int len = 0;
+      for (; i < t && flag[i] != k; i = parent[i]) {
+        pattern[len++] = i;
+        flag[i] = k;
+      }
+      while (len > 0) pattern[--top] = pattern[--len];
+    }
+    for (; top < n; ++top) {
+      const int i = pattern[top];
+      // Column i's entries above the block so far (those inside it go to the
+      // block through the Schur update).
+      const int begin = Lp[i], end = Lp[i] + above[i];
+      bool consecutive = end - begin >= 2;
+      for (int p = begin + 1; consecutive && p < end; ++p) consecutive = Li[p] == Li[begin] + (p - begin);
+      pr.steps.push_back({i, Lp[i] + filled[i], end, consecutive ? Li[begin] : -1});
+      Li[Lp[i] + filled[i]] = k;
+      ++filled[i];
+      if (k < t) ++above[i];
+    }
+    pr.row_step[k + 1] = static_cast<int>(pr.steps.size());
+  }
+  pr.block_begin.resize(t);
+  pr.heavy.resize(t);
+  for (int i = 0; i < t; ++i) {
+    pr.block_begin[i] = Lp[i] + above[i];
+    pr.heavy[i] = Lp[i + 1] - pr.block_begin[i] >= kHeavyColumn;
+  }
+}
+
+// Column j of the dense block, column-major in S (m x m, lower triangle):
+// divided by its pivot dj into L's column, then the trailing columns
+// updated by it, and their pivots' scales.
+inline void eliminateDenseColumn(double* S, int m, int j, double dj, double* scale) {
+  double* colj = S + static_cast<std::size_t>(j) * m;
+  const double inv = 1.0 / dj;
+  for (int r = j + 1; r < m; ++r) colj[r] *= inv;  // now L's column
+  for (int c = j + 1; c < m; ++c) {
+    const double w = colj[c] * dj;
+    double* colc = S + static_cast<std::size_t>(c) * m;
+    for (int r = c; r < m; ++r) colc[r] -= w * colj[r];
+    scale[c] += std::abs(w * colj[c]);
+  }
+}
+
+}  // namespace
+
+// factor() and solve() are compiled for AVX2 as well, chosen at run time
+// (ACYCLIC_VECTOR_CLONES): twice the doubles per instruction in the loops the
+// compiler vectorizes, the same operations in the same order (no fused
+// multiply-add), so the same results bit for bit.
+ACYCLIC_VECTOR_CLONES int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const int* perm,
+                         const int* parent, const int* colcount, int* Lp, int* Li, double* Lx, double* D,
+                         int* negative) {
+  Scratch& s = scratch();
+  Program& pr = s.program;
+  if (!pr.matches(n, nz, irn, jcn, perm)) makeProgram(pr, n, nz, irn, jcn, perm, parent, colcount);
+  const std::vector<int>& colptr = pr.colptr;
+  const std::vector<int>& rows = pr.rows;
+  const std::vector<int>& src = pr.src;
 
   Lp[0] = 0;
   for (int c = 0; c < n; ++c) Lp[c + 1] = Lp[c] + colcount[c];
-  const int t = denseStart(n, [colcount](int c) { return colcount[c]; }), m = n - t;
-  std::vector<int>& work = s.work;  // flag[n], filled[n], pattern[n]
-  work.assign(3 * static_cast<std::size_t>(n), 0);
-  int* flag = work.data();
-  int* filled = flag + n;
-  int* pattern = filled + n;
+  const int t = pr.t, m = pr.m;
   std::vector<double>& y = s.y;
   y.assign(n, 0.0);
   // The trailing block, column-major (lower triangle used), and the scale
@@ -188,25 +300,15 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
     if (dk < 0) ++*negative;
     return true;
   };
+  const Program::Step* step = pr.steps.data();
   for (int k = 0; k < n; ++k) {
-    // Nonzero pattern of row k of L left of the trailing block: the paths up
-    // the elimination tree from the entries of column k of the upper
-    // triangle, as far as the block (inside it every column is full).
-    int top = n;
-    flag[k] = k;
+    // Row k of L left of the trailing block (the program's steps), its
+    // column k of the matrix scattered first (inside the block: straight
+    // into it).
     for (int p = colptr[k]; p < colptr[k + 1]; ++p) {
-      int i = rows[p];
-      if (i >= t) {  // inside the block: straight into it (k >= t too)
-        S[static_cast<std::size_t>(i - t) * m + (k - t)] += a[src[p]];
-        continue;
-      }
-      y[i] += a[src[p]];
-      int len = 0;
-      for (; i < t && flag[i] != k; i = parent[i]) {
-        pattern[len++] = i;
-        flag[i] = k;
-      }
-      while (len > 0) pattern[--top] = pattern[--len];
+      const int i = rows[p];
+      if (i >= t) S[static_cast<std::size_t>(i - t) * m + (k - t)] += a[src[p]];
+      else y[i] += a[src[p]];
     }
     double dk = 0, sc = 0;
     if (k < t) {
@@ -214,22 +316,26 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
       sc = std::abs(dk);
       y[k] = 0.0;
     }
-    for (; top < n; ++top) {
-      const int i = pattern[top];
+    const Program::Step* const last = pr.steps.data() + pr.row_step[k + 1];
+    for (; step < last; ++step) {
+      const int i = step->col;
       const double yi = y[i];
       y[i] = 0.0;
-      // Column i's entries above the block (those below it, filled by the
-      // block's earlier rows, go to the block through the update below).
-      const int end = Lp[i] + filled[i];
-      for (int p = Lp[i]; p < end && Li[p] < t; ++p) y[Li[p]] -= Lx[p] * yi;
+      if (step->first_row >= 0) {
+        double* __restrict yr = y.data() + step->first_row;
+        const double* __restrict lx = Lx + Lp[i];
+        const int len = step->update_end - Lp[i];
+        for (int q = 0; q < len; ++q) yr[q] -= lx[q] * yi;
+      } else {
+        for (int p = Lp[i]; p < step->update_end; ++p) y[Li[p]] -= Lx[p] * yi;
+      }
       const double lki = yi / D[i];
       if (k < t) {
         dk -= lki * yi;
         sc += std::abs(lki * yi);
       }
-      Li[end] = k;
-      Lx[end] = lki;
-      ++filled[i];
+      Li[step->write] = k;
+      Lx[step->write] = lki;
     }
     if (k < t && !pivot(k, dk, sc)) return k + 1;
   }
@@ -246,11 +352,10 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
   auto& heavy = s.heavy;
   heavy.clear();
   for (int i = 0; i < t; ++i) {
-    int b = Lp[i + 1];
-    while (b > Lp[i] && Li[b - 1] >= t) --b;
+    const int b = pr.block_begin[i];
     const int e = Lp[i + 1];
     for (int p = b; p < e; ++p) scale[Li[p] - t] += std::abs(Lx[p] * D[i] * Lx[p]);
-    if (e - b >= kHeavyColumn) {
+    if (pr.heavy[i]) {
       heavy.emplace_back(i, b);
       continue;
     }
@@ -286,14 +391,7 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
     double* colj = S.data() + static_cast<std::size_t>(j) * m;
     const double dj = colj[j];
     if (!pivot(t + j, dj, scale[j])) return t + j + 1;
-    const double inv = 1.0 / dj;
-    for (int r = j + 1; r < m; ++r) colj[r] *= inv;  // now L's column
-    for (int c = j + 1; c < m; ++c) {
-      const double w = colj[c] * dj;
-      double* colc = S.data() + static_cast<std::size_t>(c) * m;
-      for (int r = c; r < m; ++r) colc[r] -= w * colj[r];
-      scale[c] += std::abs(w * colj[c]);
-    }
+    eliminateDenseColumn(S.data(), m, j, dj, scale.data());
     int p = Lp[t + j];
     for (int r = j + 1; r < m; ++r, ++p) {
       Li[p] = t + r;
@@ -303,19 +401,31 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
   return 0;
 }
 
-void solve(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D, double* b,
-           double* work) {
+ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
+                         double* b, double* work) {
   // Columns from t on are the dense trailing block (factor): each holds every
   // row below its diagonal, contiguously in Lx, and is swept without indices.
   const int t = denseStart(n, [Lp](int c) { return Lp[c + 1] - Lp[c]; });
   for (int k = 0; k < n; ++k) work[k] = b[perm[k]];
   for (int j = 0; j < t; ++j) {
     const double xj = work[j];
-    for (int p = Lp[j]; p < Lp[j + 1]; ++p) work[Li[p]] -= Lx[p] * xj;
+    const int begin = Lp[j], end = Lp[j + 1];
+    // A column's rows increase: first and last tell a consecutive run (the
+    // nearly full columns of the configuration), updated without indices.
+    if (end - begin >= 2 && Li[end - 1] - Li[begin] == end - begin - 1) {
+      double* __restrict w = work + Li[begin];
+      const double* __restrict l = Lx + begin;
+      for (int q = 0; q < end - begin; ++q) w[q] -= l[q] * xj;
+    } else {
+      for (int p = begin; p < end; ++p) work[Li[p]] -= Lx[p] * xj;
+    }
   }
   for (int j = t; j < n; ++j) {
     const int len = n - 1 - j;
-    Eigen::Map<Eigen::VectorXd>(work + j + 1, len) -= work[j] * Eigen::Map<const Eigen::VectorXd>(Lx + Lp[j], len);
+    const double xj = work[j];
+    double* __restrict w = work + j + 1;
+    const double* __restrict l = Lx + Lp[j];
+    for (int q = 0; q < len; ++q) w[q] -= l[q] * xj;
   }
   for (int j = 0; j < n; ++j) work[j] /= D[j];
   for (int j = n - 1; j >= t; --j) {
