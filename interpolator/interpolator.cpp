@@ -95,6 +95,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.plan_body_path = opt.plan_body_path;
   to.free_limb_paths = opt.free_limb_paths;
   to.refine_depth = opt.refine_depth;
+  to.wide_clearance = opt.wide_clearance;
   to.posture.max_iterations = opt.posture_iterations;
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
   to.posture.problem.collision_cutoff = opt.collision_cutoff;

@@ -117,8 +117,16 @@ struct TransitionSolver::Attempt {
   std::vector<MotionPiece> pieces;
 };
 
+namespace {
+PostureGeneratorOptions widened(PostureGeneratorOptions o, double clearance) {
+  o.problem.collision_margin += clearance;
+  return o;
+}
+}  // namespace
+
 TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options)
-    : sc_(sc), opt_(std::move(options)), generator_(sc.robot, sc.scene, opt_.posture), checker_(sc.robot, sc.scene),
+    : sc_(sc), opt_(std::move(options)), generator_(sc.robot, sc.scene, opt_.posture),
+      wide_generator_(sc.robot, sc.scene, widened(opt_.posture, opt_.wide_clearance)), checker_(sc.robot, sc.scene),
       kin_(sc.robot) {
   if (opt_.steps < 1) throw std::invalid_argument("steps must be at least 1");
   // Thousands of checks in sequence, for their verdict only: pairs that
@@ -230,13 +238,21 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     // and their optimum can jump from one branch to another between two steps
     // (a trunk along a table's edge, a knee by 0.06 rad), a jump no refinement
     // makes valid: then each knot also near its neighbour, as a Move's.
-    out.ok = solveFixed(plan, d, false, at);
-    if (!out.ok && !at.cancelled) {
-      const std::string first = at.reason;
+    // Last, both again with more clearance for the knots (wide_clearance).
+    std::string reasons;
+    for (int attempt = 0; attempt < 4 && !out.ok && !at.cancelled; ++attempt) {
+      const bool follow = attempt % 2 == 1, wide = attempt >= 2;
+      if (wide && !(opt_.wide_clearance > 0)) break;
       at.pieces.clear();
-      out.ok = out.repaired = solveFixed(plan, d, true, at);
-      if (!out.ok && !at.cancelled) at.reason = first + "; each knot near its neighbour too: " + at.reason;
+      out.ok = solveFixed(plan, d, follow, wide, at);
+      out.repaired = out.ok && attempt > 0;
+      if (!out.ok && !at.cancelled) {
+        const char* what[] = {"", "each knot near its neighbour too: ", "with more clearance: ",
+                              "with more clearance, each knot near its neighbour: "};
+        reasons += (attempt ? "; " : "") + std::string(what[attempt]) + at.reason;
+      }
     }
+    if (!out.ok && !at.cancelled) at.reason = reasons;
   } else {
     // The body's ends: its pose in each witness, and the surface normal where it leaves or reaches one.
     BodyPathEnd e0, e1;
@@ -347,7 +363,8 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   return out;
 }
 
-bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, Attempt& at) {
+bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide, Attempt& at) {
+  PostureGenerator& generator = wide ? wide_generator_ : generator_;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   if (distance(q0, q1) < 1e-9) return true;  // the witnesses coincide: only the contacts' support changes
@@ -362,12 +379,12 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
     r.initial_guess = guess;
     const Configuration ref = lerp(q0, q1, alpha);
     r.cost = std::make_shared<ReferencePostureCost>(follow ? lerp(guess, ref, 0.5) : ref);
-    PostureResult res = generator_.solve(r);
+    PostureResult res = generator.solve(r);
     ++at.posture_calls;
     at.posture_seconds += res.seconds;
     if (!res.success()) {  // from the interpolated witnesses instead of the previous step
       r.initial_guess = ref;
-      res = generator_.solve(r);
+      res = generator.solve(r);
       ++at.posture_calls;
       at.posture_seconds += res.seconds;
     }

@@ -99,6 +99,14 @@ struct TransitionOptions {
   // pulled along a path of its own, with this weight (ReferencePostureCost::SpotTarget).
   bool free_limb_paths = true;
   double free_limb_weight = 100;
+  // A fixed-contact transition whose knots cannot be made valid at the
+  // posture generator's collision margin is solved once more with this much
+  // more clearance for its knots (m; 0: no such try). Knots that hug an
+  // obstacle at the margin (a trunk under a table top) can sit on different
+  // sides of a corner of the distance function, and the straight segment
+  // between two of them dips below the margin however densely refined; a
+  // little more room takes the dip.
+  double wide_clearance = 0.003;
   int refine_depth = 3;              // halvings of a segment whose inside fails the check
   int segment_checks = 1;            // points checked inside each segment before timing (its middle)
   // After timing, every sample the piece will give is checked, and refined
@@ -127,8 +135,9 @@ class TransitionSolver {
 
  private:
   struct Attempt;
-  // `follow`: the cost also holds each knot near the previous one.
-  bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, Attempt& at);
+  // `follow`: the cost also holds each knot near the previous one; `wide`:
+  // the knots solved with the margin plus wide_clearance.
+  bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide, Attempt& at);
   // `orientation_tolerance`: the body's orientation off its path's in the air (PoseTarget).
   struct FreeEnd;
   // `free_ends`: the end of each limb without contacts pulled along a path
@@ -142,6 +151,7 @@ class TransitionSolver {
   const Scenario& sc_;
   TransitionOptions opt_;
   PostureGenerator generator_;
+  PostureGenerator wide_generator_;  // collision margin + wide_clearance
   ValidityChecker checker_;
   Kinematics kin_;
 };

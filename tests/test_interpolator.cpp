@@ -585,6 +585,31 @@ TEST(Interpolator, WeightShiftWithTheTrunkAlongTheTableEdge) {
   expectValid(r.trajectory, sc);
 }
 
+TEST(Interpolator, WeightShiftUnderTheTableTopWithMoreClearance) {
+  // From the chair's plan of session 11: crouched between the chair and the
+  // table, the abdomen 5 mm under the table top in both witnesses, the
+  // weight goes from the right foot to the left while the waist moves 13 cm
+  // sideways and up. At the collision margin the knots slide along the
+  // table's underside on either side of a corner of the box-box distance,
+  // and the segments between them dip 4-7 mm into it however refined
+  // (nearest the witnesses' interpolation or each near its neighbour); with
+  // 3 mm more clearance for the knots they do not.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_under_table_shift.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  EXPECT_EQ(r.trajectory.stats.repairs, 1);
+  expectValid(r.trajectory, sc);
+  opt.wide_clearance = 0;
+  const InterpolationResult u = interpolate(plan, sc, opt);
+  EXPECT_EQ(u.status, InterpolationResult::Status::TransitionFailed);
+  EXPECT_NE(u.reason.find("stances 0 -> 1"), std::string::npos) << u.reason;
+  EXPECT_NE(u.reason.find("table_top"), std::string::npos) << u.reason;
+}
+
 TEST(Interpolator, FootDetoursPastTheChairLegBesideTheOtherFoot) {
   // No bridge clears a chair leg 0.28 m high; the repair whose path carries
   // the foot farthest from the obstacles and from the planted foot steps
