@@ -251,7 +251,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
                                              "depth_weight: 0.02, failure_memory: false, failure_memory_distance: 0.1, "
                                              "failure_memory_angle: 0.5, posture_linear_solver: mumps, "
                                              "posture_lbfgs_in_kkt: true, alternative_step: 0.05, "
-                                             "posture_stop_at_restoration: false, posture_mu_oracle: probing}\n"));
+                                             "posture_stop_at_restoration: false, posture_mu_oracle: probing, "
+                                             "posture_distance_engine: convex}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -270,6 +271,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_TRUE(plannerParameters(plain).posture.stop_at_restoration);  // the planner's default
   EXPECT_EQ(p.posture.mu_oracle, "probing");
   EXPECT_EQ(plannerParameters(plain).posture.mu_oracle, "quality-function");
+  EXPECT_EQ(p.posture.distance_engine, DistanceEngine::Convex);
+  EXPECT_EQ(plannerParameters(plain).posture.distance_engine, DistanceEngine::Fcl);  // the planner's default
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
            {"planner: {max_node: 5}\n", "planner.max_node"},
@@ -282,7 +285,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {failure_memory: maybe}\n", "planner.failure_memory"},
            {"planner: {posture_linear_solver: pardiso}\n", "planner.posture_linear_solver"},
            {"planner: {posture_lbfgs_in_kkt: sometimes}\n", "planner.posture_lbfgs_in_kkt"},
-           {"planner: {posture_mu_oracle: fast}\n", "planner.posture_mu_oracle"}}) {
+           {"planner: {posture_mu_oracle: fast}\n", "planner.posture_mu_oracle"},
+           {"planner: {posture_distance_engine: bullet}\n", "planner.posture_distance_engine"}}) {
     const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
     try {
       plannerParameters(sc);

@@ -143,10 +143,8 @@ struct PostureGenerator::Ipopt {
 
 PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
                                    PostureGeneratorOptions options)
-    // Distances by convex::separation, several times faster than FCL's GJK
-    // (collision_model.h); the checks keep FCL's.
     : robot_(std::move(robot)), scene_(std::move(scene)),
-      collision_(std::make_shared<CollisionModel>(robot_, scene_, DistanceEngine::Convex)), opt_(options),
+      collision_(std::make_shared<CollisionModel>(robot_, scene_, options.distance_engine)), opt_(options),
       ipopt_(std::make_unique<Ipopt>()) {
   (void)acyclic_mumps_lock_linked();  // keeps the interposers' library in every link
   auto& app = ipopt_->app;

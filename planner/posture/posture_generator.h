@@ -55,6 +55,13 @@ struct PostureGeneratorOptions {
   // cheap with "ldl"), or "loqo". See README "Posture generator" for the
   // measurements behind the default.
   std::string mu_oracle = "quality-function";
+  // Pair distances: DistanceEngine::Convex (convex_distance.h: GJK on the
+  // primitives' cores, several times faster than FCL's, session 11) or
+  // DistanceEngine::Fcl (FCL's GJK, as the independent checks). The planner
+  // keeps Fcl (PlannerParameters): its searches are chaotic in the
+  // witnesses, and the chair's plan with Convex has a step the interpolator
+  // cannot make (README "The chair scenario: solved").
+  DistanceEngine distance_engine = DistanceEngine::Convex;
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).
   std::vector<std::string> ipopt_options;

@@ -8,7 +8,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   const YamlField& f = *sc.planner_section;
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
-               "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle",
+               "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -58,6 +58,11 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     const std::string v = f["posture_mu_oracle"].string();
     if (v != "quality-function" && v != "probing" && v != "loqo") f["posture_mu_oracle"].fail("quality-function, probing or loqo");
     p.posture.mu_oracle = v;
+  }
+  if (f.has("posture_distance_engine")) {
+    const std::string v = f["posture_distance_engine"].string();
+    if (v != "fcl" && v != "convex") f["posture_distance_engine"].fail("fcl or convex");
+    p.posture.distance_engine = v == "fcl" ? DistanceEngine::Fcl : DistanceEngine::Convex;
   }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
