@@ -139,18 +139,29 @@ TEST(ShapeDistance, MatchesBruteForceOnSeparatedPrimitives) {
   EXPECT_GT(compared, 40);
 }
 
+namespace {
+// A capsule (radius 5 cm) lying flat on a slab 10 cm thick whose top is at
+// z = 0.05, its axis along x, `depth` into the slab's top.
+struct CapsuleOnSlab {
+  CollisionShape box, cap;
+  Eigen::Isometry3d Tb = Eigen::Isometry3d::Identity(), Tc = Eigen::Isometry3d::Identity();
+  explicit CapsuleOnSlab(double depth) {
+    box.kind = Kind::Box;
+    box.size = Eigen::Vector3d(1, 1, 0.1);
+    cap.kind = Kind::Capsule;
+    cap.radius = 0.05;
+    cap.length = 0.3;
+    Tc.linear() = expSO3(Eigen::Vector3d(0, M_PI / 2, 0));
+    Tc.translation() = Eigen::Vector3d(0.1, 0, 0.05 + 0.05 - depth);
+  }
+};
+}  // namespace
+
 TEST(ShapeDistance, PenetrationIsNegativeWithItsDepth) {
-  CollisionShape box;
-  box.kind = Kind::Box;
-  box.size = Eigen::Vector3d(1, 1, 0.1);
-  CollisionShape cap;
-  cap.kind = Kind::Capsule;
-  cap.radius = 0.05;
-  cap.length = 0.3;
-  Eigen::Isometry3d Tb = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d Tc = Eigen::Isometry3d::Identity();
-  Tc.linear() = expSO3(Eigen::Vector3d(0, M_PI / 2, 0));  // lying flat, axis along x
-  Tc.translation() = Eigen::Vector3d(0.1, 0, 0.05 + 0.05 - 0.004);  // 4 mm into the box's top
+  CapsuleOnSlab c(0.004);  // 4 mm into the box's top
+  const CollisionShape &box = c.box, &cap = c.cap;
+  const Eigen::Isometry3d& Tb = c.Tb;
+  Eigen::Isometry3d& Tc = c.Tc;
   EXPECT_NEAR(shapeDistance(cap, Tc, box, Tb), -0.004, 1e-5);
   Tc.translation().z() += 0.01;
   EXPECT_NEAR(shapeDistance(cap, Tc, box, Tb), 0.006, 1e-6);
@@ -349,18 +360,11 @@ TEST(ConvexSeparation, MatchesBruteForceAndFclOnSeparatedPrimitives) {
 }
 
 TEST(ConvexSeparation, ASweepsPenetrationIsExactAndOverlappingCoresAreSaid) {
-  CollisionShape box;
-  box.kind = Kind::Box;
-  box.size = Eigen::Vector3d(1, 1, 0.1);
-  CollisionShape cap;
-  cap.kind = Kind::Capsule;
-  cap.radius = 0.05;
-  cap.length = 0.3;
-  const convex::Primitive pbox = convex::primitiveOf(box), pcap = convex::primitiveOf(cap);
-  Eigen::Isometry3d Tb = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d Tc = Eigen::Isometry3d::Identity();
-  Tc.linear() = expSO3(Eigen::Vector3d(0, M_PI / 2, 0));  // lying flat, axis along x
-  Tc.translation() = Eigen::Vector3d(0.1, 0, 0.05 + 0.05 - 0.004);  // 4 mm into the box's top
+  CapsuleOnSlab c(0.004);  // 4 mm into the box's top
+  const CollisionShape& box = c.box;
+  const convex::Primitive pbox = convex::primitiveOf(c.box), pcap = convex::primitiveOf(c.cap);
+  const Eigen::Isometry3d& Tb = c.Tb;
+  Eigen::Isometry3d& Tc = c.Tc;
   convex::Separation s = convex::separation(pcap, Tc, pbox, Tb);
   ASSERT_FALSE(s.cores_overlap);
   EXPECT_NEAR(s.distance, -0.004, 1e-12);

@@ -527,10 +527,11 @@ Plan chairPlanStances(const Scenario& sc, std::size_t first, std::size_t last) {
 }
 
 // The plan (every stance kept) interpolates with one transition repaired and
-// every sample valid; without what `disable` turns off, it is reported
-// unrepairable, naming `stances`.
+// every sample valid; without what `disable` turns off, it fails with
+// `failed` (a moving body's transition: unrepairable), naming `stances`.
 void expectRepairedOnlyWith(const Plan& plan, const Scenario& sc, const std::function<void(InterpolatorOptions&)>& disable,
-                            const std::string& stances) {
+                            const std::string& stances,
+                            InterpolationResult::Status failed = InterpolationResult::Status::Unrepairable) {
   InterpolatorOptions opt;
   opt.filter = false;
   const InterpolationResult r = interpolate(plan, sc, opt);
@@ -539,7 +540,7 @@ void expectRepairedOnlyWith(const Plan& plan, const Scenario& sc, const std::fun
   expectValid(r.trajectory, sc);
   disable(opt);
   const InterpolationResult u = interpolate(plan, sc, opt);
-  EXPECT_EQ(u.status, InterpolationResult::Status::Unrepairable);
+  EXPECT_EQ(u.status, failed);
   EXPECT_NE(u.reason.find(stances), std::string::npos) << u.reason;
 }
 
@@ -597,17 +598,8 @@ TEST(Interpolator, WeightShiftUnderTheTableTopWithMoreClearance) {
   const Scenario& sc = chairScenario();
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_under_table_shift.plan.json"), sc);
   ASSERT_EQ(plan.stances.size(), 2u);
-  InterpolatorOptions opt;
-  opt.filter = false;
-  const InterpolationResult r = interpolate(plan, sc, opt);
-  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
-  EXPECT_EQ(r.trajectory.stats.repairs, 1);
-  expectValid(r.trajectory, sc);
-  opt.wide_clearance = 0;
-  const InterpolationResult u = interpolate(plan, sc, opt);
-  EXPECT_EQ(u.status, InterpolationResult::Status::TransitionFailed);
-  EXPECT_NE(u.reason.find("stances 0 -> 1"), std::string::npos) << u.reason;
-  EXPECT_NE(u.reason.find("table_top"), std::string::npos) << u.reason;
+  expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.wide_clearance = 0; }, "stances 0 -> 1",
+                         InterpolationResult::Status::TransitionFailed);
 }
 
 TEST(Interpolator, FootDetoursPastTheChairLegBesideTheOtherFoot) {
