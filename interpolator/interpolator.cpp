@@ -48,6 +48,7 @@ std::string validateOptions(const InterpolatorOptions& o) {
     return "the orientation tolerance in the air must be in [0, 1)";
   if (o.repair_attempts < 0 || !(o.repair_step > 0) || o.refine_depth < 0 || o.posture_iterations < 1)
     return "repair attempts, refinement depth and posture iterations must be non-negative, the repair step positive";
+  if (!(o.wide_clearance >= 0 && o.wide_clearance < 0.05)) return "the wide clearance must be in [0, 0.05) m";
   if (o.threads < 1) return "threads must be at least 1";
   return "";
 }

@@ -117,18 +117,16 @@ struct TransitionSolver::Attempt {
   std::vector<MotionPiece> pieces;
 };
 
-namespace {
-PostureGeneratorOptions widened(PostureGeneratorOptions o, double clearance) {
-  o.problem.collision_margin += clearance;
-  return o;
-}
-}  // namespace
-
 TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options)
-    : sc_(sc), opt_(std::move(options)), generator_(sc.robot, sc.scene, opt_.posture),
-      wide_generator_(sc.robot, sc.scene, widened(opt_.posture, opt_.wide_clearance)), checker_(sc.robot, sc.scene),
+    : sc_(sc), opt_(std::move(options)), generator_(sc.robot, sc.scene, opt_.posture), checker_(sc.robot, sc.scene),
       kin_(sc.robot) {
   if (opt_.steps < 1) throw std::invalid_argument("steps must be at least 1");
+  if (!(opt_.wide_clearance >= 0)) throw std::invalid_argument("wide_clearance must be non-negative");
+  if (opt_.wide_clearance > 0) {
+    PostureGeneratorOptions wide = opt_.posture;
+    wide.problem.collision_margin += opt_.wide_clearance;
+    wide_generator_.emplace(sc.robot, sc.scene, wide);
+  }
   // Thousands of checks in sequence, for their verdict only: pairs that
   // cannot be within 2 cm are not measured, and the equilibrium LPs start
   // from the previous check's basis (validity.h).
@@ -242,7 +240,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     std::string reasons;
     for (int attempt = 0; attempt < 4 && !out.ok && !at.cancelled; ++attempt) {
       const bool follow = attempt % 2 == 1, wide = attempt >= 2;
-      if (wide && !(opt_.wide_clearance > 0)) break;
+      if (wide && !wide_generator_) break;
       at.pieces.clear();
       out.ok = solveFixed(plan, d, follow, wide, at);
       out.repaired = out.ok && attempt > 0;
@@ -364,7 +362,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
 }
 
 bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide, Attempt& at) {
-  PostureGenerator& generator = wide ? wide_generator_ : generator_;
+  PostureGenerator& generator = wide ? *wide_generator_ : generator_;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   if (distance(q0, q1) < 1e-9) return true;  // the witnesses coincide: only the contacts' support changes

@@ -151,7 +151,7 @@ class TransitionSolver {
   const Scenario& sc_;
   TransitionOptions opt_;
   PostureGenerator generator_;
-  PostureGenerator wide_generator_;  // collision margin + wide_clearance
+  std::optional<PostureGenerator> wide_generator_;  // collision margin + wide_clearance, if that is positive
   ValidityChecker checker_;
   Kinematics kin_;
 };

@@ -281,8 +281,9 @@ TEST_F(ChairCollisionConvex, EnginesAgreeOnEveryPairNearTheChair) {
   // Postures around the start, some penetrating the seat or the table: every
   // one of the 316 pairs by both engines. Separated pairs agree to FCL's own
   // accuracy (its GJK on curved shapes stops within a few micrometres);
-  // where the cores overlap the Convex engine hands the pair to FCL, so the
-  // two agree exactly.
+  // penetrating ones are penetrating by both (the depth is FCL's estimate,
+  // by MPR, where the cores overlap, and exact by the Convex engine where
+  // only a capsule's or a sphere's sweep penetrates).
   Kinematics k(sc.robot);
   std::mt19937 rng(29);
   std::normal_distribution<double> n(0, 0.15);
@@ -379,4 +380,56 @@ TEST(ConvexSeparation, ASweepsPenetrationIsExactAndOverlappingCoresAreSaid) {
   CollisionShape small = box;
   small.size = Eigen::Vector3d(0.1, 0.1, 0.1);
   EXPECT_TRUE(convex::separation(convex::primitiveOf(small), Eigen::Isometry3d::Identity(), pbox, Tb).cores_overlap);
+}
+
+TEST(ConvexSeparation, ASweepsPenetrationMovesAlongItsNormalAndParallelFacesAreExact) {
+  // A capsule or a sphere whose sweep (not its core) is inside the other
+  // shape: the distance, negative, changes along the normal at rate 1 when
+  // the other shape moves (what the posture generator's gradients use).
+  std::mt19937 rng(41);
+  int compared = 0;
+  for (int trial = 0; trial < 2000 && compared < 40; ++trial) {
+    const CollisionShape a = randomShape(rng, trial % 2 ? Kind::Capsule : Kind::Sphere);
+    const CollisionShape b = randomShape(rng, trial % 3 ? Kind::Box : Kind::Capsule);
+    const convex::Primitive pa = convex::primitiveOf(a), pb = convex::primitiveOf(b);
+    const Eigen::Isometry3d Ta = randomPose(rng, 0.15), Tb = randomPose(rng, 0.15);
+    const convex::Separation s = convex::separation(pa, Ta, pb, Tb);
+    if (s.cores_overlap || s.distance > -1e-3 || s.distance < -0.02) continue;
+    EXPECT_NEAR((s.point_b - s.point_a - s.distance * s.normal).norm(), 0, 1e-12);
+    const double h = 1e-6;
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Isometry3d Tp = Tb, Tm = Tb;
+      Tp.translation()[k] += h;
+      Tm.translation()[k] -= h;
+      const double rate =
+          (convex::separation(pa, Ta, pb, Tp).distance - convex::separation(pa, Ta, pb, Tm).distance) / (2 * h);
+      EXPECT_NEAR(rate, s.normal[k], 1e-6) << "trial " << trial;
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 20);
+  // Faces and axes exactly parallel (a foot flat over the floor, two limbs
+  // side by side): GJK's simplex turns flat or collinear there.
+  CollisionShape slab, foot, cap;
+  slab.kind = foot.kind = Kind::Box;
+  slab.size = Eigen::Vector3d(1, 1, 0.1);
+  foot.size = Eigen::Vector3d(0.22, 0.14, 0.09);
+  cap.kind = Kind::Capsule;
+  cap.radius = 0.05;
+  cap.length = 0.16;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (double gap : {0.02, 1e-3, 1e-6}) {
+    T.translation() = Eigen::Vector3d(0.1, -0.2, 0.05 + 0.045 + gap);
+    const convex::Separation s =
+        convex::separation(convex::primitiveOf(foot), T, convex::primitiveOf(slab), Eigen::Isometry3d::Identity());
+    ASSERT_FALSE(s.cores_overlap) << gap;
+    EXPECT_NEAR(s.distance, gap, 1e-12);
+    EXPECT_NEAR((s.normal - Eigen::Vector3d(0, 0, -1)).norm(), 0, 1e-9);
+  }
+  // Two capsules side by side, their axes parallel, 1.4 cm between their sweeps.
+  T.translation() = Eigen::Vector3d(0.11, 0.03, -0.02);
+  const convex::Separation c =
+      convex::separation(convex::primitiveOf(cap), T, convex::primitiveOf(cap), Eigen::Isometry3d::Identity());
+  ASSERT_FALSE(c.cores_overlap);
+  EXPECT_NEAR(c.distance, std::hypot(0.11, 0.03) - 0.1, 1e-12);
 }

@@ -210,12 +210,14 @@ PairDistance CollisionModel::pairDistance(const Kinematics& kin, int i, bool gra
   PairDistance d;
   d.pair = i;
   bool found = false;
+  Eigen::Vector3d core_normal = Eigen::Vector3d::Zero();  // the Convex engine's, from A toward B
   if (engine_ == DistanceEngine::Convex) {
     const convex::Separation s = convex::separation(geom_->robot_primitive[p.link_a][p.shape_a], Ta, *cb, Tb);
     if (!s.cores_overlap) {
       d.distance = s.distance;
       d.point_a = s.point_a;
       d.point_b = s.point_b;
+      core_normal = s.normal;
       found = true;
     }
   }
@@ -223,10 +225,13 @@ PairDistance CollisionModel::pairDistance(const Kinematics& kin, int i, bool gra
   if (gradient) {
     // d = n . (pb - pa) with n = (pb - pa) / d for either sign of d, so
     // grad d = n^T (J_b(pb) - J_a(pa)). At contact (d ~ 0) the witness
-    // points coincide; the line between the shapes' centres stands in for n.
+    // points coincide: the cores' normal stands in for n where the Convex
+    // engine has one, else the line between the shapes' centres.
     Eigen::Vector3d n;
     if (std::abs(d.distance) > 1e-9 && (d.point_b - d.point_a).norm() > 1e-9)
       n = (d.point_b - d.point_a) / d.distance;
+    else if (found)
+      n = core_normal;
     else
       n = (Tb.translation() - Ta.translation()).normalized();
     d.gradient = Eigen::VectorXd::Zero(robot_->tangentSize());

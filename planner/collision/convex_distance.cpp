@@ -214,6 +214,7 @@ Separation separation(const Primitive& a, const Eigen::Isometry3d& Ta, const Pri
   out.distance = core - a.sweep - b.sweep;
   out.point_a = Ta * pa;
   out.point_b = Ta * pb;
+  out.normal = Ta.linear() * n;
   return out;
 }
 

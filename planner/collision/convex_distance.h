@@ -11,9 +11,12 @@
 // third of a posture call (perf, session 11). This one works in the first
 // shape's frame with support functions that are a few sign tests.
 //
-// It answers separated shapes only: when the cores overlap (penetration
-// deeper than the radii) it says so, and the caller asks FCL for the
-// penetration depth (CollisionModel).
+// It answers separated cores only: when they overlap (penetration deeper
+// than the radii) it says so, and the caller asks FCL for the penetration
+// depth (CollisionModel). Where a capsule's or a sphere's core first
+// touches, the distance (exactly minus its radius up to there) then becomes
+// FCL's estimate of the depth: continuous to that estimate's accuracy only.
+// An optimizer meets it only from a start deep in an obstacle.
 #include <Eigen/Geometry>
 
 #include "planner/model/robot_model.h"
@@ -33,9 +36,13 @@ struct Primitive {
 Primitive primitiveOf(const CollisionShape& s);
 
 struct Separation {
-  bool cores_overlap = false;  // distance and points are meaningless then
+  bool cores_overlap = false;  // distance, points and normal are meaningless then
   double distance = 0;         // between the swept shapes: negative when a sweep penetrates
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero(), point_b = Eigen::Vector3d::Zero();  // world witness points
+  // Unit, world, from the first core's nearest point toward the second's:
+  // point_b - point_a = distance * normal for either sign of distance (and
+  // the normal is still there when the shapes just touch).
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   int iterations = 0;
 };
 

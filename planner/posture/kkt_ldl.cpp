@@ -1,5 +1,6 @@
 #include "planner/posture/kkt_ldl.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -10,7 +11,15 @@ namespace acyclic::kkt {
 
 namespace {
 
+// factor() and solve() are compiled for AVX2 as well, chosen at run time on
+// x86-64 (GCC's target_clones). The file is compiled with -ffp-contract=off
+// (planner/CMakeLists.txt), so no clone fuses a multiply and an add: the
+// results are the same bit for bit on any machine.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define ACYCLIC_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define ACYCLIC_VECTOR_CLONES
+#endif
 
 // Relative size under which a pivot counts as zero: a few hundred roundings.
 constexpr double kZeroPivot = 1e-13;
@@ -46,7 +55,6 @@ struct Program {
   // Li/Lx, and whether they update it densely (heavy) or entry by entry.
   std::vector<int> block_begin;
   std::vector<char> heavy;
-  int heavy_pos = 0, heavy_neg = 0;  // unknown until D's signs: counted per factorization
   bool matches(int n_, int nz_, const int* irn_, const int* jcn_, const int* perm_) const {
     return n == n_ && nz == nz_ && std::equal(irn.begin(), irn.end(), irn_) &&
            std::equal(jcn.begin(), jcn.end(), jcn_) && std::equal(perm.begin(), perm.end(), perm_);
@@ -198,10 +206,7 @@ namespace {
 // recorded instead of computed on.
 void makeProgram(Program& pr, int n, int nz, const int* irn, const int* jcn, const int* perm, const int* parent,
                  const int* colcount) {
-  pr.n = n, pr.nz = nz;
-  pr.irn.assign(irn, irn + nz);
-  pr.jcn.assign(jcn, jcn + nz);
-  pr.perm.assign(perm, perm + n);
+  pr.n = -1;  // matches nothing until it is whole (an allocation may throw on the way)
   std::vector<int>& pinv = scratch().pinv;
   pinv.resize(n);
   for (int i = 0; i < n; ++i) pinv[perm[i]] = i;
@@ -248,12 +253,17 @@ void makeProgram(Program& pr, int n, int nz, const int* irn, const int* jcn, con
     pr.block_begin[i] = Lp[i] + above[i];
     pr.heavy[i] = Lp[i + 1] - pr.block_begin[i] >= kHeavyColumn;
   }
+  pr.irn.assign(irn, irn + nz);
+  pr.jcn.assign(jcn, jcn + nz);
+  pr.perm.assign(perm, perm + n);
+  pr.nz = nz;
+  pr.n = n;
 }
 
 // Column j of the dense block, column-major in S (m x m, lower triangle):
 // divided by its pivot dj into L's column, then the trailing columns
 // updated by it, and their pivots' scales.
-inline void eliminateDenseColumn(double* S, int m, int j, double dj, double* scale) {
+__attribute__((always_inline)) inline void eliminateDenseColumn(double* S, int m, int j, double dj, double* scale) {
   double* colj = S + static_cast<std::size_t>(j) * m;
   const double inv = 1.0 / dj;
   for (int r = j + 1; r < m; ++r) colj[r] *= inv;  // now L's column
@@ -267,10 +277,9 @@ inline void eliminateDenseColumn(double* S, int m, int j, double dj, double* sca
 
 }  // namespace
 
-// factor() and solve() are compiled for AVX2 as well, chosen at run time
-// (ACYCLIC_VECTOR_CLONES): twice the doubles per instruction in the loops the
-// compiler vectorizes, the same operations in the same order (no fused
-// multiply-add), so the same results bit for bit.
+// Compiled for AVX2 as well (ACYCLIC_VECTOR_CLONES): twice the doubles per
+// instruction in the loops the compiler vectorizes, the same operations in
+// the same order.
 ACYCLIC_VECTOR_CLONES int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const int* perm,
                          const int* parent, const int* colcount, int* Lp, int* Li, double* Lx, double* D,
                          int* negative) {

@@ -28,8 +28,11 @@
 // bench_posture: the linear algebra's time a fifth lower than all sparse.
 //
 // All state lives in caller-owned arrays, as with HSL's MA27, whose calling
-// sequence Ipopt's linear-solver loader accepts (ipopt_ldl.cpp): two solvers
-// on two threads share nothing.
+// sequence Ipopt's linear-solver loader accepts (ipopt_ldl.cpp), but for
+// what a factorization keeps of the last pattern it saw (the pattern-only
+// part of its work, replayed while the pattern stays: checked against the
+// whole pattern first) and its scratch, both per thread: two solvers on two
+// threads share nothing.
 #include <string>
 
 namespace acyclic::kkt {

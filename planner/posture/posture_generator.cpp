@@ -154,7 +154,8 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
   o->SetIntegerValue("print_level", opt_.print_level);
   if (opt_.print_level >= 4) o->SetStringValue("print_timing_statistics", "yes");
   if (opt_.hessian != "diagonal" && opt_.hessian != "lbfgs" && opt_.hessian != "analytic")
-    throw std::invalid_argument("PostureGeneratorOptions::hessian: expected lbfgs, analytic or diagonal");
+    throw std::invalid_argument("PostureGeneratorOptions::hessian: expected lbfgs, analytic or diagonal, got '" +
+                                opt_.hessian + "'");
   o->SetStringValue("hessian_approximation", opt_.hessian == "lbfgs" ? "limited-memory" : "exact");
   if (opt_.hessian == "lbfgs" && opt_.lbfgs_in_kkt) o->SetStringValue("limited_memory_aug_solver", "extended");
   if (opt_.linear_solver == "ldl") {
@@ -170,11 +171,13 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
     o->SetNumericValue("ma27_pivtolmax", 1e-8);       // no pivoting: nothing to raise
     o->SetNumericValue("ma27_pivtol", 1e-8);
   } else if (opt_.linear_solver != "mumps") {
-    throw std::invalid_argument("PostureGeneratorOptions::linear_solver: expected ldl or mumps");
+    throw std::invalid_argument("PostureGeneratorOptions::linear_solver: expected ldl or mumps, got '" +
+                                opt_.linear_solver + "'");
   }
   o->SetStringValue("mu_strategy", "adaptive");
   if (opt_.mu_oracle != "quality-function" && opt_.mu_oracle != "probing" && opt_.mu_oracle != "loqo")
-    throw std::invalid_argument("PostureGeneratorOptions::mu_oracle: expected quality-function, probing or loqo");
+    throw std::invalid_argument("PostureGeneratorOptions::mu_oracle: expected quality-function, probing or loqo, got '" +
+                                opt_.mu_oracle + "'");
   o->SetStringValue("mu_oracle", opt_.mu_oracle);
   o->SetNumericValue("tol", opt_.tolerance);
   o->SetNumericValue("constr_viol_tol", opt_.tolerance);
