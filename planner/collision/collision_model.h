@@ -45,8 +45,8 @@ double shapeDistance(const CollisionShape& a, const Eigen::Isometry3d& Ta, const
 // shapes, its collide() for the depth of penetrating ones; the independent
 // checks use it. Convex: convex::separation (convex_distance.h) for
 // separated shapes, several times faster, and FCL when the shapes' cores
-// overlap; the posture generator uses it, so that the check's distances come
-// from other code than the generator's.
+// overlap; the posture generator's default (PostureGeneratorOptions), so that
+// the check's distances come from other code than the generator's.
 enum class DistanceEngine { Fcl, Convex };
 
 class CollisionModel {

@@ -52,7 +52,7 @@ struct PostureGeneratorOptions {
   // How Ipopt's adaptive barrier parameter is chosen at each iteration
   // (Ipopt's mu_oracle): "quality-function" (Ipopt's default) or "probing"
   // (Mehrotra's affine-scaling probe: one more back-solve per iteration,
-  // cheap with "ldl"), or "loqo". See README "Posture generator" for the
+  // cheap with "ldl"), or "loqo". README "Figures" (session 11) has the
   // measurements behind the default.
   std::string mu_oracle = "quality-function";
   // Pair distances: DistanceEngine::Convex (convex_distance.h: GJK on the
