@@ -2,13 +2,16 @@
 // each scenario planned with the hand-written key postures and with the OMPL
 // guide only, side by side in one run: wall time, nodes, plan length, and the
 // independent check's verdict on each plan (planner/check/plan_check.h).
-// Usage: bench_guide [SCENARIO...] [--seeds N] [--max-seconds T]
+// Usage: bench_guide [SCENARIO...] [OPTIONS]; --help lists the options.
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_checks.h"
 
 #include "planner/check/plan_check.h"
 #include "planner/guide/guide_author.h"
@@ -21,20 +24,17 @@ int main(int argc, char** argv) {
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::vector<std::string> paths;
   int seeds = 5;
-  double max_seconds = -1;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
-      std::printf("Usage: %s [SCENARIO...] [--seeds N] [--max-seconds T]\n"
-                  "The OMPL guide's time on each scenario (default: every models/scenarios/*.yaml), median over\n"
-                  "seeds 1..N, then each planned with its hand-written guide and with the OMPL guide, each plan\n"
-                  "checked by the independent check (valid / INVALID).\n",
-                  argv[0]);
-      return 0;
-    }
-    if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
-    else paths.push_back(argv[i]);
-  }
+  double max_seconds = -1;  // not given: each scenario's budget
+  CLI::App app{"The OMPL guide author: its time on each scenario (median over seeds), then each scenario planned\n"
+               "with the hand-written key postures and with the OMPL guide only, side by side in one run: wall time,\n"
+               "nodes, plan length, and the independent check's verdict on each plan."};
+  app.add_option("scenario", paths, "scenario files (acyclic.scenario/1; default: every models/scenarios/*.yaml)");
+  app.add_option("--seeds", seeds, "the guide author is timed with seeds 1..N (median and max printed)")
+      ->check(acyclic::bench::positive())
+      ->capture_default_str();
+  app.add_option("--max-seconds", max_seconds, "time budget per planning run, s (default: the scenario's)")
+      ->check(acyclic::bench::positive());
+  CLI11_PARSE(app, argc, argv);
   if (paths.empty()) {  // every shipped scenario
     for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
       if (e.path().extension() == ".yaml") paths.push_back(e.path().string());

@@ -1,9 +1,12 @@
 // The contact planner with each of the paper's ideas switched off in turn,
 // side by side in one run: wall time, nodes, posture calls and failures, plan
-// length. Usage: bench_planner [SCENARIO] [--max-seconds T]
+// length. Usage: bench_planner [SCENARIO] [OPTIONS]; --help lists the options.
 #include <cstdio>
-#include <cstring>
 #include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_checks.h"
 
 #include "planner/search/planner_parameters.h"
 #include "planner/posture/heap_tuning.h"
@@ -13,17 +16,13 @@ using namespace acyclic;
 int main(int argc, char** argv) {
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::string path = ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml";
-  double max_seconds = -1;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
-      std::printf("Usage: %s [SCENARIO] [--max-seconds T]\n"
-                  "Plans the scenario (default: the chair) with the full planner and with each ablation.\n",
-                  argv[0]);
-      return 0;
-    }
-    if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
-    else path = argv[i];
-  }
+  double max_seconds = -1;  // not given: the scenario's budget
+  CLI::App app{"The contact planner with each of the paper's ideas switched off in turn, side by side in one run:\n"
+               "wall time, nodes, posture calls and failures, plan length."};
+  app.add_option("scenario", path, "scenario file (acyclic.scenario/1)")->capture_default_str();
+  app.add_option("--max-seconds", max_seconds, "time budget per run, s (default: the scenario's)")
+      ->check(acyclic::bench::positive());
+  CLI11_PARSE(app, argc, argv);
   const Scenario sc = Scenario::load(path);
   struct Variant {
     const char* name;

@@ -12,6 +12,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.h"
+
 #include "planner/check/validity.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/posture/posture_generator.h"
@@ -98,7 +100,7 @@ int main(int argc, char** argv) {
                "subsets, start guesses, floating contacts; some infeasible): success rate, time per call for\n"
                "successes and for failures (median, 90th percentile), iterations, and how many successes the\n"
                "independent check accepts."};
-  app.add_option("--problems", n, "number of problems")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--problems", n, "number of problems")->check(acyclic::bench::positive())->capture_default_str();
   app.add_option("--seed", seed, "seed of the problem set")->capture_default_str();
   app.add_option("--max-seconds", opt.max_seconds, "CPU time limit per call, s")->capture_default_str();
   app.add_option("--max-iterations", opt.max_iterations, "iteration limit per call")->capture_default_str();

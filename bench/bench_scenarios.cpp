@@ -2,14 +2,17 @@
 // after the other in one run: result, wall time, nodes, posture calls and
 // failures, plan length, the non-foot contacts the plan uses, and the
 // independent check's verdict on the plan.
-// Usage: bench_scenarios [SCENARIO...] [--max-seconds T]   (default: every shipped scenario)
+// Usage: bench_scenarios [SCENARIO...] [OPTIONS]   (default: every shipped scenario); --help lists the options.
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_checks.h"
 
 #include "planner/check/plan_check.h"
 #include "planner/posture/heap_tuning.h"
@@ -20,18 +23,14 @@ using namespace acyclic;
 int main(int argc, char** argv) {
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::vector<std::string> paths;
-  double max_seconds = -1;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
-      std::printf("Usage: %s [SCENARIO...] [--max-seconds T]\n"
-                  "Plans each scenario (default: every models/scenarios/*.yaml) with the full planner and prints\n"
-                  "its figures and the independent check's verdict on the plan.\n",
-                  argv[0]);
-      return 0;
-    }
-    if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
-    else paths.push_back(argv[i]);
-  }
+  double max_seconds = -1;  // not given: each scenario's budget
+  CLI::App app{"Every scenario shipped in models/scenarios planned by the full planner, one after the other in one\n"
+               "run: result, wall time, nodes, posture calls and failures, plan length, the non-foot contacts the\n"
+               "plan uses, and the independent check's verdict on the plan."};
+  app.add_option("scenario", paths, "scenario files (acyclic.scenario/1; default: every models/scenarios/*.yaml)");
+  app.add_option("--max-seconds", max_seconds, "time budget per scenario, s (default: the scenario's)")
+      ->check(acyclic::bench::positive());
+  CLI11_PARSE(app, argc, argv);
   if (paths.empty()) {
     for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
       if (e.path().extension() == ".yaml") paths.push_back(e.path().string());
