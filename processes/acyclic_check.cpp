@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "processes/command_line.h"
 #include "planner/check/plan_check.h"
 #include "planner/check/trajectory_check.h"
 #include "planner/common/format_error.h"
@@ -45,7 +46,7 @@ int main(int argc, char** argv) {
                  "trajectory file (format acyclic.trajectory/1) to check against the scenario, sample by sample")
       ->excludes("--plan");
   app.add_flag("-v,--verbose", verbose, "print every check of every stance, not only the failing ones");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   try {
     const acyclic::Scenario sc = acyclic::Scenario::load(scenario_path);

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "processes/command_line.h"
 #include "planner/common/format_error.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/guide/guide_author.h"
@@ -39,7 +40,7 @@ int main(int argc, char** argv) {
   app.add_option("--penetration", o.penetration, "robot-scene penetration allowed along the guide, m")
       ->capture_default_str();
   app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   proc::installSignalHandlers();
   if (lcm_mode) return serveGuide(url, o);

@@ -20,6 +20,7 @@
 #include <optional>
 #include <thread>
 
+#include "processes/command_line.h"
 #include "acyclic/hrp2_bridge_status_t.hpp"
 #include "acyclic/hrp2_command_t.hpp"
 #include "acyclic/hrp2_estop_t.hpp"
@@ -120,7 +121,7 @@ int main(int argc, char** argv) {
   bool lcm_flag = false;
   app.add_flag("--lcm", lcm_flag, "accepted for symmetry with the other processes (LCM mode is the default without --trajectory)");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   const bool file_mode = !trajectory_path.empty();
   if (file_mode && lcm_flag) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "processes/command_line.h"
 #include "hrp2_bridge/contract_check.h"
 #include "hrp2_bridge/prepared_trajectory.h"
 #include "hrp2_bridge/sequence_player.h"
@@ -35,7 +36,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-contract", no_contract, "skip the validity contract check (the limits are always checked)");
   app.add_option("--zmp-stride", zmp_stride, "quasi-static LP every N samples, interpolated between (default 10)")
       ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   hrp2::LoadedTrajectory lt;
   hrp2::BridgeConfig cfg;

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <thread>
 
+#include "processes/command_line.h"
 #include "acyclic/hrp2_command_t.hpp"
 #include "acyclic/hrp2_state_t.hpp"
 #include "channels.hpp"
@@ -83,7 +84,7 @@ int main(int argc, char** argv) {
   bool lcm_flag = false;
   app.add_flag("--lcm", lcm_flag, "accepted for symmetry with the other processes (the simulator always serves LCM)");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.servo_on = !servo_off;
 
   std::unique_ptr<hrp2::SimulatedController> sim;

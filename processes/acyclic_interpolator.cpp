@@ -13,6 +13,7 @@
 #include <fstream>
 #include <unistd.h>
 
+#include "processes/command_line.h"
 #include "interpolator/interpolator.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/common/format_error.h"
@@ -82,7 +83,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.filter = !no_filter;
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   if (lcm_mode) {

@@ -16,6 +16,7 @@
 #include <optional>
 #include <sstream>
 
+#include "processes/command_line.h"
 #include "acyclic/hrp2_bridge_status_t.hpp"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/process_status_t.hpp"
@@ -118,7 +119,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--planner-arg", planner_args, "extra argument for acyclic-planner (repeatable)");
   app.add_flag("-q,--quiet", quiet, "no progress line");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   Scenario sc;
   try {

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "processes/command_line.h"
 #include "planner/common/format_error.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/plan/guide.h"
@@ -52,7 +53,7 @@ int main(int argc, char** argv) {
                "ablation: try every pair at every node, even where it just failed from the same place");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
 
   acyclic::proc::installSignalHandlers();

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "processes/command_line.h"
 #include "acyclic/progress_t.hpp"
 #include "lcmtypes/channels.hpp"
 #include "planner/common/format_error.h"
@@ -58,7 +59,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1000.0));
   app.add_option("--out", out, "output folder (created)")->required();
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   if (trajectory_path.empty() && log_path.empty()) {
     std::fprintf(stderr, "acyclic-plot: nothing to plot: give --trajectory and/or --log\n");
     return 2;

@@ -9,6 +9,7 @@
 
 #include <cstdio>
 
+#include "processes/command_line.h"
 #include "planner/check/validity.h"
 #include "planner/common/format_error.h"
 #include "planner/posture/heap_tuning.h"
@@ -42,11 +43,16 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", seconds, "CPU seconds at most")->capture_default_str();
   app.add_option("--print-level", print_level, "Ipopt's print level (0-12), to see why a solve fails")
       ->check(CLI::Range(0, 12));
+  std::string engine = "convex";
+  app.add_option("--distance-engine", engine,
+                 "collision distances: convex (the posture generator's default) or fcl (the planner's)")
+      ->check(CLI::IsMember({"convex", "fcl"}))
+      ->capture_default_str();
   app.add_option("--ipopt", ipopt, "a further Ipopt option NAME=VALUE (repeatable)");
   app.add_option("--out", out,
                  "write the witness as a one-stance plan (acyclic.plan/1) with the stance once the change settles "
                  "(removed contacts gone, the added one supporting): the input of a next --from");
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   try {
     const Scenario sc = Scenario::load(scenario_path);
@@ -82,6 +88,7 @@ int main(int argc, char** argv) {
     o.max_seconds = seconds;
     o.print_level = print_level;
     o.ipopt_options = ipopt;
+    o.distance_engine = engine == "fcl" ? DistanceEngine::Fcl : DistanceEngine::Convex;
     PostureGenerator pg(sc.robot, sc.scene, o);
     const PostureResult res = pg.solve(r);
     std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s\n", toString(res.status), res.iterations,

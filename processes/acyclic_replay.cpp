@@ -17,6 +17,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "processes/command_line.h"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/process_status_t.hpp"
 #include "acyclic/request_t.hpp"
@@ -76,7 +77,7 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--bin-dir", bin_dir, "where the acyclic-* executables are (default: beside this one)");
   app.add_option("--timeout", timeout_s, "seconds to wait for each answer")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   // What the log holds.
   std::vector<request_t> requests;

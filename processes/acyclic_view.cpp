@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "processes/command_line.h"
 #include "planner/common/format_error.h"
 #include "viewer/export/view_data.h"
 
@@ -51,7 +52,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1000.0));
   app.add_option("--page", page_dir, "folder holding the built page (index.html, viewer.js)")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   Scenario sc;
   Plan plan;

@@ -43,4 +43,23 @@ TEST(AcyclicPosture, BadInputIsNamedAndExitsTwo) {
   r = probe("--add l_wrist@ceiling");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("ceiling"), std::string::npos) << r.output;
+  // A bad option or value on the command line is bad input too, named.
+  r = probe("--distance-engine bullet");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--distance-engine"), std::string::npos) << r.output;
+  r = probe("--print-level 13");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--print-level"), std::string::npos) << r.output;
+  r = probe("--no-such-option");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--no-such-option"), std::string::npos) << r.output;
+}
+
+TEST(AcyclicPosture, TheSameStanceWithEitherDistanceEngine) {
+  // The planner's distances (FCL) and the generator's default (its own GJK)
+  // find the same stance valid.
+  for (const char* engine : {"fcl", "convex"}) {
+    const auto r = probe(std::string("--remove r_thigh --distance-engine ") + engine);
+    EXPECT_EQ(r.status, 0) << engine << "\n" << r.output;
+  }
 }
