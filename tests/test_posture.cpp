@@ -4,6 +4,7 @@
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <functional>
 #include <random>
 #include <regex>
@@ -13,6 +14,7 @@
 #include "planner/check/quasi_static.h"
 #include "planner/check/validity.h"
 #include "planner/plan/plan.h"
+#include "planner/posture/kkt_ldl.h"
 #include "planner/posture/posture_generator.h"
 #include "test_support.h"
 
@@ -439,6 +441,36 @@ TEST(PostureGenerator, HalfSittingDoubleSupport) {  // (b)
   for (const auto& c : res.forces)
     for (const auto& f : c.forces) fz += f.z();
   EXPECT_NEAR(fz, sc.robot->totalMass() * 9.81, 1e-3);
+}
+
+namespace {
+std::atomic<int> observed{0}, observed_rows{0};
+void countSystem(int n, int nz, const int*, const int*, const double*) {
+  ++observed;
+  observed_rows = n;
+}
+}  // namespace
+
+TEST(PostureGenerator, ItsKktSystemsReachAnObserverWhileOneIsSet) {
+  // bench_kkt collects Ipopt's systems through kkt::observeFactorizations:
+  // each factorization of a solve is seen, a system as large as the problem
+  // (its variables, two rows per inequality, one per equality), and none
+  // once the observer is gone.
+  const Scenario& sc = chair();
+  PostureGenerator pg(sc.robot, sc.scene);
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  acyclic::kkt::observeFactorizations(countSystem);
+  const PostureResult res = pg.solve(r);
+  acyclic::kkt::observeFactorizations(nullptr);
+  ASSERT_TRUE(res.success()) << res.reason;
+  EXPECT_GT(observed.load(), 0);
+  EXPECT_GE(observed.load(), res.iterations);
+  EXPECT_GT(observed_rows.load(), 36 + 2 * 30);  // 36 coordinates, 30 two-sided torque rows at least
+  const int seen = observed.load();
+  pg.solve(r);
+  EXPECT_EQ(observed.load(), seen);
 }
 
 TEST(PostureGenerator, LeftWristAnywhereOnTheTable) {  // (c)

@@ -9,6 +9,7 @@
 //   A         = D[N] | Lx   (on entry to MA27BD: the matrix's values)
 // MA27's pivot tolerance (CNTL(1)) has no meaning here: there is no pivoting.
 #include <algorithm>
+#include <atomic>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -30,6 +31,8 @@ void LSL_setMA27(ma27ad_t, ma27bd_t, ma27cd_t, ma27id_t);
 namespace acyclic::kkt {
 
 namespace {
+
+std::atomic<MatrixObserver> observer{nullptr};
 
 // MA27's INFO(1) codes that Ipopt's interface acts on.
 constexpr int kOk = 0, kFatal = -1, kIwTooSmall = -3, kATooSmall = -4, kSingular = 3;
@@ -77,6 +80,7 @@ void factorEntry(int* N, int* NZ, const int* IRN, const int* ICN, double* A, int
     INFO[1] = static_cast<int>(reals);
     return;
   }
+  if (const MatrixObserver o = observer.load()) o(n, nz, IRN, ICN, A);
   thread_local std::vector<double> values;
   values.assign(A, A + nz);  // the factors overwrite them
   std::copy(perm, perm + n, IW);
@@ -96,6 +100,8 @@ void solveEntry(int* N, double* A, int*, int* IW, int*, double* W, int*, double*
 }
 
 }  // namespace
+
+void observeFactorizations(MatrixObserver o) { observer.store(o); }
 
 void registerWithIpopt() {
   static std::once_flag once;

@@ -63,4 +63,12 @@ void solve(int n, const int* perm, const int* Lp, const int* Li, const double* L
 // that select it are set by PostureGenerator (linear_solver "ldl").
 void registerWithIpopt();
 
+// Called with each matrix Ipopt hands to factor() through registerWithIpopt's
+// entry, before it is factorized (triplets 1-based, as in factor()): for a
+// benchmark that times the factorization on real systems (bench/bench_kkt).
+// nullptr: none (the default). Process-wide; the call is on the solving
+// thread.
+using MatrixObserver = void (*)(int n, int nz, const int* irn, const int* jcn, const double* a);
+void observeFactorizations(MatrixObserver observer);
+
 }  // namespace acyclic::kkt
