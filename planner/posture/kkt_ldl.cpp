@@ -52,9 +52,11 @@ struct Program {
   std::vector<int> row_step;
   std::vector<Step> steps;
   // Columns left of the block: where their rows inside the block start in
-  // Li/Lx, and whether they update it densely (heavy) or entry by entry.
+  // Li/Lx, and whether they update it densely (heavy) or entry by entry;
+  // the heavy ones in order.
   std::vector<int> block_begin;
   std::vector<char> heavy;
+  std::vector<int> heavy_columns;
   bool matches(int n_, int nz_, const int* irn_, const int* jcn_, const int* perm_) const {
     return n == n_ && nz == nz_ && std::equal(irn.begin(), irn.end(), irn_) &&
            std::equal(jcn.begin(), jcn.end(), jcn_) && std::equal(perm.begin(), perm.end(), perm_);
@@ -65,22 +67,22 @@ struct Program {
 // the program, which is checked against the pattern before each use).
 struct Scratch {
   Program program;
-  std::vector<int> pinv;                     // permutedUpper's inverse permutation
-  std::vector<int> next;                     // permutedUpper's fill positions
   std::vector<double> y;                     // factor's row being eliminated
   std::vector<double> schur, scale;          // the dense trailing block, its pivots' scales
-  std::vector<std::pair<int, int>> heavy;    // columns whose block rows are gathered densely, where those start
-  Eigen::MatrixXd g_pos, g_neg;              // those rows times sqrt|D|, by the sign of D
+  Eigen::MatrixXd g_pos, g_neg;              // heavy columns' block rows times sqrt|D|, by the sign of D
 };
 Scratch& scratch() {
   thread_local Scratch s;
   return s;
 }
 
-// Column k of the permuted upper triangle, as CSC: colptr[n+1], rows and
-// the triplet each entry comes from (so that values map without a copy).
-void permutedUpper(int n, int nz, const int* irn, const int* jcn, const int* pinv, std::vector<int>& colptr,
+// Column k of the matrix permuted by perm (perm[new] = old), upper triangle,
+// as CSC: colptr[n+1], rows and the triplet each entry comes from (so that
+// values map without a copy).
+void permutedUpper(int n, int nz, const int* irn, const int* jcn, const int* perm, std::vector<int>& colptr,
                    std::vector<int>& rows, std::vector<int>& src) {
+  std::vector<int> pinv(n);
+  for (int i = 0; i < n; ++i) pinv[perm[i]] = i;
   colptr.assign(n + 1, 0);
   for (int k = 0; k < nz; ++k) {
     const int i = pinv[irn[k] - 1], j = pinv[jcn[k] - 1];
@@ -89,8 +91,7 @@ void permutedUpper(int n, int nz, const int* irn, const int* jcn, const int* pin
   for (int j = 0; j < n; ++j) colptr[j + 1] += colptr[j];
   rows.resize(nz);
   src.resize(nz);
-  std::vector<int>& next = scratch().next;
-  next.assign(colptr.begin(), colptr.end() - 1);
+  std::vector<int> next(colptr.begin(), colptr.end() - 1);  // each column's next free position
   for (int k = 0; k < nz; ++k) {
     const int i = pinv[irn[k] - 1], j = pinv[jcn[k] - 1];
     const int col = i > j ? i : j, p = next[col]++;
@@ -110,6 +111,13 @@ int denseStart(int n, Count count) {
   int t = n;
   while (t > 0 && count(t - 1) == n - t) --t;
   return n - t >= kMinDense ? t : n;
+}
+
+// Whether entries [begin, end) of a column of L hold consecutive rows: its
+// rows increase, so first and last tell (the configuration's nearly full
+// columns, updated without indices).
+inline bool consecutiveRows(const int* Li, int begin, int end) {
+  return end - begin >= 2 && Li[end - 1] - Li[begin] == end - begin - 1;
 }
 
 }  // namespace
@@ -177,10 +185,8 @@ long analyse(int n, int nz, const int* irn, const int* jcn, int* perm, int* pare
 
   // Elimination tree and column counts of the permuted matrix (LDL's
   // symbolic pass, up-looking).
-  std::vector<int> pinv(n);
-  for (int i = 0; i < n; ++i) pinv[perm[i]] = i;
   std::vector<int> colptr, rows, src;
-  permutedUpper(n, nz, irn, jcn, pinv.data(), colptr, rows, src);
+  permutedUpper(n, nz, irn, jcn, perm, colptr, rows, src);
   std::vector<int> flag(n);
   long total = 0;
   for (int c = 0; c < n; ++c) {
@@ -207,10 +213,7 @@ namespace {
 void makeProgram(Program& pr, int n, int nz, const int* irn, const int* jcn, const int* perm, const int* parent,
                  const int* colcount) {
   pr.n = -1;  // matches nothing until it is whole (an allocation may throw on the way)
-  std::vector<int>& pinv = scratch().pinv;
-  pinv.resize(n);
-  for (int i = 0; i < n; ++i) pinv[perm[i]] = i;
-  permutedUpper(n, nz, irn, jcn, pinv.data(), pr.colptr, pr.rows, pr.src);
+  permutedUpper(n, nz, irn, jcn, perm, pr.colptr, pr.rows, pr.src);
   const int t = denseStart(n, [colcount](int c) { return colcount[c]; });
   pr.t = t, pr.m = n - t;
   std::vector<int> Lp(n + 1);
@@ -238,9 +241,7 @@ void makeProgram(Program& pr, int n, int nz, const int* irn, const int* jcn, con
       // Column i's entries above the block so far (those inside it go to the
       // block through the Schur update).
       const int begin = Lp[i], end = Lp[i] + above[i];
-      bool consecutive = end - begin >= 2;
-      for (int p = begin + 1; consecutive && p < end; ++p) consecutive = Li[p] == Li[begin] + (p - begin);
-      pr.steps.push_back({i, Lp[i] + filled[i], end, consecutive ? Li[begin] : -1});
+      pr.steps.push_back({i, Lp[i] + filled[i], end, consecutiveRows(Li.data(), begin, end) ? Li[begin] : -1});
       Li[Lp[i] + filled[i]] = k;
       ++filled[i];
       if (k < t) ++above[i];
@@ -249,9 +250,11 @@ void makeProgram(Program& pr, int n, int nz, const int* irn, const int* jcn, con
   }
   pr.block_begin.resize(t);
   pr.heavy.resize(t);
+  pr.heavy_columns.clear();
   for (int i = 0; i < t; ++i) {
     pr.block_begin[i] = Lp[i] + above[i];
     pr.heavy[i] = Lp[i + 1] - pr.block_begin[i] >= kHeavyColumn;
+    if (pr.heavy[i]) pr.heavy_columns.push_back(i);
   }
   pr.irn.assign(irn, irn + nz);
   pr.jcn.assign(jcn, jcn + nz);
@@ -358,16 +361,11 @@ ACYCLIC_VECTOR_CLONES int factor(int n, int nz, const int* irn, const int* jcn, 
   // scaled by sqrt|D|, and S -= G+ G+^T - G- G-^T as two symmetric rank
   // updates (Eigen's blocked kernels).
   for (int j = 0; j < m; ++j) scale[j] = std::abs(S[static_cast<std::size_t>(j) * m + j]);  // |a_jj|
-  auto& heavy = s.heavy;
-  heavy.clear();
   for (int i = 0; i < t; ++i) {
     const int b = pr.block_begin[i];
     const int e = Lp[i + 1];
     for (int p = b; p < e; ++p) scale[Li[p] - t] += std::abs(Lx[p] * D[i] * Lx[p]);
-    if (pr.heavy[i]) {
-      heavy.emplace_back(i, b);
-      continue;
-    }
+    if (pr.heavy[i]) continue;
     for (int p = b; p < e; ++p) {
       const int c = Li[p] - t;
       const double w = Lx[p] * D[i];
@@ -375,18 +373,18 @@ ACYCLIC_VECTOR_CLONES int factor(int n, int nz, const int* irn, const int* jcn, 
       for (int q = p; q < e; ++q) col[Li[q] - t] -= w * Lx[q];
     }
   }
-  if (!heavy.empty()) {
+  if (!pr.heavy_columns.empty()) {
     int npos = 0, nneg = 0;
-    for (const auto& [i, b] : heavy) (D[i] > 0 ? npos : nneg)++;
+    for (int i : pr.heavy_columns) (D[i] > 0 ? npos : nneg)++;
     Eigen::MatrixXd& Gp = s.g_pos;
     Eigen::MatrixXd& Gn = s.g_neg;
     Gp.setZero(m, npos);
     Gn.setZero(m, nneg);
     int ip = 0, in = 0;
-    for (const auto& [i, b] : heavy) {
+    for (int i : pr.heavy_columns) {
       const double r = std::sqrt(std::abs(D[i]));
       double* g = D[i] > 0 ? Gp.col(ip++).data() : Gn.col(in++).data();
-      for (int p = b; p < Lp[i + 1]; ++p) g[Li[p] - t] = Lx[p] * r;
+      for (int p = pr.block_begin[i]; p < Lp[i + 1]; ++p) g[Li[p] - t] = Lx[p] * r;
     }
     Eigen::Map<Eigen::MatrixXd> Sm(S.data(), m, m);
     if (npos) Sm.selfadjointView<Eigen::Lower>().rankUpdate(Gp, -1.0);
@@ -419,9 +417,7 @@ ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const in
   for (int j = 0; j < t; ++j) {
     const double xj = work[j];
     const int begin = Lp[j], end = Lp[j + 1];
-    // A column's rows increase: first and last tell a consecutive run (the
-    // nearly full columns of the configuration), updated without indices.
-    if (end - begin >= 2 && Li[end - 1] - Li[begin] == end - begin - 1) {
+    if (consecutiveRows(Li, begin, end)) {  // the configuration's nearly full columns: no indices
       double* __restrict w = work + Li[begin];
       const double* __restrict l = Lx + begin;
       for (int q = 0; q < end - begin; ++q) w[q] -= l[q] * xj;
