@@ -59,11 +59,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   std::string engine = "convex";
   app.add_option("--distance-engine", engine, "pair distances: convex (GJK on the primitives' cores) or fcl")
-      ->check(CLI::IsMember({"convex", "fcl"}))
+      ->check([](const std::string& v) { return distanceEngineNamed(v) ? std::string() : "expected convex or fcl"; })
       ->capture_default_str();
   app.add_option("--ipopt", opt.ipopt_options, "further Ipopt option name=value (repeatable)");
   CLI11_PARSE(app, argc, argv);
-  opt.distance_engine = engine == "fcl" ? DistanceEngine::Fcl : DistanceEngine::Convex;
+  opt.distance_engine = *distanceEngineNamed(engine);
   const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml");
   std::unique_ptr<PostureGenerator> made;
   try {

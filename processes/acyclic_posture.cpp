@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   std::string engine = "convex";
   app.add_option("--distance-engine", engine,
                  "collision distances: convex (the posture generator's default) or fcl (the planner's)")
-      ->check(CLI::IsMember({"convex", "fcl"}))
+      ->check([](const std::string& v) { return distanceEngineNamed(v) ? std::string() : "expected convex or fcl"; })
       ->capture_default_str();
   app.add_option("--ipopt", ipopt, "a further Ipopt option NAME=VALUE (repeatable)");
   app.add_option("--out", out,
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
     o.max_seconds = seconds;
     o.print_level = print_level;
     o.ipopt_options = ipopt;
-    o.distance_engine = engine == "fcl" ? DistanceEngine::Fcl : DistanceEngine::Convex;
+    o.distance_engine = *distanceEngineNamed(engine);
     PostureGenerator pg(sc.robot, sc.scene, o);
     const PostureResult res = pg.solve(r);
     std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s\n", toString(res.status), res.iterations,

@@ -101,6 +101,12 @@ struct CollisionModel::Geometry {
   std::vector<fcl::AABBd> obstacle_aabb;  // world
 };
 
+std::optional<DistanceEngine> distanceEngineNamed(const std::string& name) {
+  if (name == "fcl") return DistanceEngine::Fcl;
+  if (name == "convex") return DistanceEngine::Convex;
+  return std::nullopt;
+}
+
 CollisionModel::CollisionModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
                                DistanceEngine engine)
     : robot_(std::move(robot)), scene_(std::move(scene)), engine_(engine), geom_(std::make_unique<Geometry>()) {

@@ -4,6 +4,7 @@
 // Jacobians for the derivatives). DESIGN.md sections 5 and 6.
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,8 @@ double shapeDistance(const CollisionShape& a, const Eigen::Isometry3d& Ta, const
 // overlap; the posture generator's default (PostureGeneratorOptions), so that
 // the check's distances come from other code than the generator's.
 enum class DistanceEngine { Fcl, Convex };
+// The engine named "fcl" or "convex" (scenario fields, command lines); none for another name.
+std::optional<DistanceEngine> distanceEngineNamed(const std::string& name);
 
 class CollisionModel {
  public:

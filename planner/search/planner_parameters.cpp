@@ -60,9 +60,9 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     p.posture.mu_oracle = v;
   }
   if (f.has("posture_distance_engine")) {
-    const std::string v = f["posture_distance_engine"].string();
-    if (v != "fcl" && v != "convex") f["posture_distance_engine"].fail("fcl or convex");
-    p.posture.distance_engine = v == "fcl" ? DistanceEngine::Fcl : DistanceEngine::Convex;
+    const auto e = distanceEngineNamed(f["posture_distance_engine"].string());
+    if (!e) f["posture_distance_engine"].fail("fcl or convex");
+    p.posture.distance_engine = *e;
   }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
