@@ -180,9 +180,7 @@ Separation separation(const Primitive& a, const Eigen::Isometry3d& Ta, const Pri
     bool repeated = false;
     for (int i = 0; i < s.n; ++i) repeated = repeated || (x.w - s.v[i].w).squaredNorm() <= 1e-30;
     if (repeated) break;
-    s.v[s.n] = x;
-    s.lambda[s.n] = 0;
-    ++s.n;
+    s.v[s.n++] = x;
     switch (s.n) {
       case 1: s.lambda[0] = 1; break;
       case 2: nearestOnSegment(s, 0, 1); break;
