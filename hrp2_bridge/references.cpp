@@ -35,7 +35,9 @@ Eigen::Vector3d alongGravity(const Eigen::Vector3d& p, const Eigen::Vector3d& po
 }  // namespace
 
 ReferenceModel::ReferenceModel(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
-    : robot_(robot), scene_(scene), kin_(robot), lp_(robot, scene) {}
+    : robot_(robot), scene_(scene), kin_(robot), lp_(robot, scene) {
+  lp_.setWarmStart(true);
+}
 
 WaistZmp ReferenceModel::compute(const Configuration& q, const std::vector<ContactSpec>& contacts,
                                  bool coplanar_feet) {

@@ -8,6 +8,13 @@
 //   LP (planner/check/quasi_static.h) - what the ankle force sensors see while
 //   hands, knees or thighs carry the rest; the CoM projection when the feet
 //   carry less than 1% of the weight or the LP has no solution (counted).
+//   Where extra contacts carry load the forces are not unique, and an LP
+//   solved from scratch lands on whichever vertex its method finds: with the
+//   eight-facet friction pyramid the feet's centre of pressure then swept
+//   23 cm in 0.15 s under a slow arm motion. Each LP therefore starts from
+//   the previous sample's optimal basis (QuasiStaticChecker::setWarmStart),
+//   so the forces move continuously while that basis stays optimal; samples
+//   are computed in order, so the same trajectory gives the same references.
 // The ZMP is given in the world and in the waist (base) frame, as the
 // SequencePlayer's .zmp file wants it.
 #include <memory>

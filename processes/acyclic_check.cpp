@@ -35,8 +35,11 @@ int main(int argc, char** argv) {
       "Checks a scenario's start stance, or a plan, against Acyclic's validity contract (DESIGN.md\n"
       "section 9): joint limits, contacts, collisions and quasi-static equilibrium for every posture;\n"
       "for a plan also the sequence (start stance first, goal met last, one contact change per step);\n"
-      "for a trajectory every sample with its phase's contacts (held within 1 mm), the joint velocity\n"
-      "limits (stored and finite-difference), zero velocity where a contact is made or broken.\n"
+      "for a plan also the forces it reports (on the contacts' corners, inside the Coulomb cone,\n"
+      "balancing gravity); for a trajectory every sample with its phase's contacts (held within 1 mm),\n"
+      "the joint velocity limits (stored and finite-difference), stored velocities against positions,\n"
+      "joint accelerations from positions within the robot's limits, rest where a contact is made or\n"
+      "broken (stored velocity and positions). Friction is the worst ||f_t|| / (mu f_n) per stance and sample.\n"
       "Exit status: 0 valid, 1 a violation, 2 bad input."};
   std::string scenario_path, plan_path, trajectory_path;
   bool verbose = false;
@@ -101,8 +104,16 @@ int main(int argc, char** argv) {
                   describeStance(sc, plan.stances[i].specs()).c_str());
       printParts(rep.stances[i], "    ");
     }
-    std::printf("  [%s] postures      %zu of %zu stances valid (joint limits, contacts, collisions, equilibrium)\n",
+    std::printf("  [%s] postures      %zu of %zu stances valid (joint limits, contacts, collisions, equilibrium, reported forces)\n",
                 bad ? "FAIL" : " ok ", rep.stances.size() - bad, rep.stances.size());
+    bool forces_ok = true;
+    for (const auto& st : rep.stances)
+      for (const auto& p : st.parts) forces_ok = forces_ok && (p.name != "reported forces" || p.ok());
+    if (rep.worst_cone_stance >= 0)
+      std::printf("  [%s] friction      reported forces: worst ||f_t|| / (mu f_n) %.3f (stance %d; at most 1 in the cone)\n",
+                  forces_ok ? " ok " : "FAIL", rep.worst_cone_ratio, rep.worst_cone_stance);
+    else
+      std::printf("  [skip] friction      the plan reports no contact force\n");
     std::printf("  [%s] sequence      start stance first, goal met last, one contact change per step\n",
                 rep.sequence_violations.empty() ? " ok " : "FAIL");
     for (const auto& v : rep.sequence_violations) std::printf("         violation: %s\n", v.c_str());

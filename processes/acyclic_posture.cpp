@@ -48,6 +48,11 @@ int main(int argc, char** argv) {
                  "collision distances: convex (the posture generator's default) or fcl (the planner's)")
       ->check([](const std::string& v) { return distanceEngineNamed(v) ? std::string() : "expected convex or fcl"; })
       ->capture_default_str();
+  int pyramid_edges = 4;
+  app.add_option("--pyramid-edges", pyramid_edges,
+                 "friction pyramid edges per corner: 4 (every other edge of the contract's) or 8 (all of them)")
+      ->check(CLI::IsMember({4, 8}))
+      ->capture_default_str();
   app.add_option("--ipopt", ipopt, "a further Ipopt option NAME=VALUE (repeatable)");
   app.add_option("--out", out,
                  "write the witness as a one-stance plan (acyclic.plan/1) with the stance once the change settles "
@@ -89,6 +94,7 @@ int main(int argc, char** argv) {
     o.print_level = print_level;
     o.ipopt_options = ipopt;
     o.distance_engine = *distanceEngineNamed(engine);
+    o.problem.pyramid_sides = pyramid_edges;
     PostureGenerator pg(sc.robot, sc.scene, o);
     const PostureResult res = pg.solve(r);
     std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s\n", toString(res.status), res.iterations,

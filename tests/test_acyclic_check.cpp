@@ -1,6 +1,7 @@
 // acyclic-check as a user runs it: exit status and what it prints.
 #include <gtest/gtest.h>
 
+#include "planner/plan/plan.h"
 #include "test_support.h"
 
 namespace {
@@ -45,6 +46,38 @@ TEST(AcyclicCheck, ViolationsArePrintedWithFiguresAndFail) {
   EXPECT_NE(r.output.find("RLEG_JOINT3"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("penetration"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("INVALID"), std::string::npos) << r.output;
+}
+
+// The forces a plan reports are what a controller would apply: forces on the
+// corners of the square pyramid (|f_x| = |f_y| = mu f_n), outside the Coulomb
+// cone, fail; the plan's own forces pass, with their worst ratio printed.
+TEST(AcyclicCheck, ReportedForcesOutsideTheConeFail) {
+  const std::string scenario = acyclic::test::sourcePath("models/scenarios/chair_table.yaml");
+  const acyclic::Scenario sc = acyclic::Scenario::load(scenario);
+  acyclic::Plan plan = acyclic::readPlan(acyclic::test::sourcePath("tests/data/chair.plan.json"), sc);
+  plan.stances.resize(1);  // the start stance alone: a plan that ends short of the goal, forces checked all the same
+  acyclic::test::TempDir dir;
+  const acyclic::test::ProcessRun good = run(scenario + " --plan " + [&] {
+    const std::string path = dir.path() + "/start.plan.json";
+    acyclic::writePlan(plan, sc, path);
+    return path;
+  }());
+  EXPECT_NE(good.output.find("[ ok ] friction      reported forces: worst ||f_t|| / (mu f_n)"), std::string::npos)
+      << good.output;
+  bool changed = false;
+  for (auto& c : plan.stances[0].contacts) {
+    if (!c.spec.supporting || sc.robot->spots()[c.spec.spot].name != "r_sole") continue;
+    const double mu = sc.scene->surfaces()[c.spec.surface].friction;
+    for (auto& f : c.forces) f = Eigen::Vector3d(mu * f.z(), mu * f.z(), f.z()), changed = true;  // the floor's normal is z
+  }
+  ASSERT_TRUE(changed);
+  const std::string path = dir.path() + "/corners.plan.json";
+  acyclic::writePlan(plan, sc, path);
+  const acyclic::test::ProcessRun bad = run(scenario + " --plan " + path + " -v");
+  EXPECT_EQ(bad.status, 1) << bad.output;
+  EXPECT_NE(bad.output.find("outside the friction cone, ||f_t|| = 1.4 mu f_n"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("[FAIL] friction      reported forces: worst ||f_t|| / (mu f_n) 1.414"), std::string::npos)
+      << bad.output;
 }
 
 TEST(AcyclicCheck, BadInputNamesTheFileAndExitsTwo) {

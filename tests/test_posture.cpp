@@ -9,6 +9,7 @@
 #include <random>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "planner/check/quasi_static.h"
@@ -16,6 +17,7 @@
 #include "planner/plan/plan.h"
 #include "planner/posture/kkt_ldl.h"
 #include "planner/posture/posture_generator.h"
+#include "planner/scene/friction.h"
 #include "test_support.h"
 
 using namespace acyclic;
@@ -783,3 +785,87 @@ TEST(QuasiStaticCheck, VerdictsWithoutTheMarginLpAgreeWithFullChecks) {
   EXPECT_GT(infeasible, 5);
   EXPECT_GT(torque_bound, 0);
 }
+
+// --- Friction: the pyramid inscribed in the Coulomb cone --------------------
+
+namespace {
+
+// A floor tilted by `tilt` about the world y axis, its surface frame turned by
+// `turn` about its normal: standing on it, gravity's reaction pulls along the
+// surface direction at 180 deg - turn in the surface frame, at tan(tilt) of
+// the normal force.
+std::shared_ptr<const Scene> tiltedFloor(const test::TempDir& dir, double tilt, double turn, double mu) {
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()));
+  std::ostringstream os;
+  os.precision(17);
+  os << "format: acyclic.scene/1\nname: tilted\nobstacles:\n"
+     << "  - {name: floor, shape: box, size: [6, 6, 0.1], position: [0, 0, -0.05]}\n"
+     << "surfaces:\n  - {name: floor, obstacle: floor, position: [0, 0, 0], friction: " << mu << ",\n"
+     << "     quaternion: [" << q.w() << ", " << q.x() << ", " << q.y() << ", " << q.z() << "],\n"
+     << "     polygon: [[-3, -3], [3, -3], [3, 3], [-3, 3]]}\n";
+  const std::string path = dir.write("tilted_" + std::to_string(turn) + ".yaml", os.str());
+  return Scene::load(path);
+}
+
+}  // namespace
+
+// Where the load pulls along a pyramid edge, friction up to mu holds it; half
+// way between two edges (a facet's middle) only mu cos(pi / 8) does. A load
+// at 0.96 mu tells the inscribed pyramid from the cone (both would hold it) and
+// from the circumscribed square pyramid (which would hold it in both
+// directions). The forces found are inside the true cone.
+TEST(QuasiStatic, FrictionIsThePyramidInscribedInTheCone) {
+  const Scenario& sc = chair();
+  test::TempDir dir;
+  const double mu = 0.5, tilt = std::atan(0.96 * mu);
+  ASSERT_GT(0.96, std::cos(M_PI / kFrictionPyramidEdges));
+  Configuration q = sc.robot->posture("half_sitting");
+  q.base_position.x() = 0, q.base_position.y() = 0;
+  Kinematics k(sc.robot);
+  k.setConfiguration(q);
+  for (const double turn : {0.0, M_PI / kFrictionPyramidEdges}) {
+    auto scene = tiltedFloor(dir, tilt, turn, mu);
+    std::vector<ContactSpec> stance;
+    for (const char* spot : {"r_sole", "l_sole"}) {
+      ContactSpec c;
+      c.spot = sc.robot->spotIndex(spot);
+      c.surface = 0;
+      c.supporting = true;
+      stance.push_back(c);
+    }
+    const QuasiStaticReport r = QuasiStaticChecker(sc.robot, scene).check(k, stance);
+    if (turn == 0) {
+      ASSERT_TRUE(r.feasible) << r.reason;
+      EXPECT_LE(r.worst_cone_ratio, 1 + 1e-9);
+      EXPECT_GT(r.worst_cone_ratio, 0.9);  // friction binds
+      const Eigen::Vector3d n = scene->surfaces()[0].frame.linear().col(2);
+      for (const auto& contact : r.forces)
+        for (const auto& f : contact) EXPECT_LE(coneRatio(f, n, mu), 1 + 1e-9);
+    } else {
+      EXPECT_FALSE(r.feasible) << "held by friction beyond the inscribed pyramid's facet";
+    }
+  }
+}
+
+TEST(QuasiStatic, ConeRatio) {
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(coneRatio(Eigen::Vector3d(0.3, 0.4, 1), n, 0.5), 1.0, 1e-12);
+  EXPECT_NEAR(coneRatio(Eigen::Vector3d(0.5, 0.5, 1), n, 0.5), std::sqrt(2.0), 1e-12);  // a square pyramid's corner
+  EXPECT_EQ(coneRatio(Eigen::Vector3d(0, 0, 2), n, 0.5), 0.0);
+  EXPECT_TRUE(std::isinf(coneRatio(Eigen::Vector3d(0.1, 0, -1), n, 0.5)));  // pulls
+}
+
+TEST(PostureProblem, PyramidEdgesMustBeTheContractsEdges) {
+  const Scenario& sc = chair();
+  PostureRequest r;
+  r.contacts = sc.start_stance;
+  r.initial_guess = sc.start;
+  auto collision = std::make_shared<CollisionModel>(sc.robot, sc.scene);
+  PostureOptions o;
+  o.pyramid_sides = 4;  // every other edge of the contract's octagon: inside it
+  EXPECT_NO_THROW(PostureProblem(sc.robot, sc.scene, collision, r, o));
+  o.pyramid_sides = 6;  // edges the contract's pyramid does not have: could reach outside it
+  EXPECT_THROW(PostureProblem(sc.robot, sc.scene, collision, r, o), std::invalid_argument);
+}
+

@@ -1,8 +1,11 @@
 #include "planner/check/quasi_static.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "planner/scene/friction.h"
 
 #include <coin/ClpSimplex.hpp>
 #include <coin/CoinPackedMatrix.hpp>
@@ -48,7 +51,18 @@ struct Lp {
     ClpSimplex model;
     load(model);
     model.initialSolve();  // presolve, then Clp's choice of method
-    return finish(model, x, warm);
+    if (model.isProvenOptimal()) return finish(model, x, warm);
+    // Clp's presolve has called feasible LPs of this kind infeasible (the
+    // friction facets make them degenerate): an infeasible verdict needs the
+    // simplex without presolve to agree, dual and then primal.
+    ClpSimplex dual;
+    load(dual);
+    dual.dual();
+    if (dual.isProvenOptimal()) return finish(dual, x, warm);
+    ClpSimplex primal;
+    load(primal);
+    primal.primal();
+    return finish(primal, x, warm);
   }
   bool finish(ClpSimplex& model, std::vector<double>& x, QuasiStaticChecker::WarmStart* warm) const {
     if (!model.isProvenOptimal()) return false;
@@ -142,14 +156,18 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
         }
       }
     }
-    // Friction pyramid: mu f_n -+ f_ti >= s (LP 1) or >= 0 (LP 2).
+    // Friction: the contract's pyramid inscribed in the cone (friction.h),
+    // by its facets: mu cos(pi/E) f_n - (cos a f_t1 + sin a f_t2) >= s (LP 1)
+    // or >= 0 (LP 2), a = 2 pi (m + 1/2) / E the facet's outward direction.
+    const double inset = std::cos(M_PI / kFrictionPyramidEdges);
     for (std::size_t k = 0; k < corners.size(); ++k)
-      for (int t = 1; t <= 2; ++t)
-        for (double sign : {1.0, -1.0}) {
-          std::vector<std::pair<int, double>> row = {{3 * k, corners[k].mu}, {3 * k + t, -sign}};
-          if (margin_lp) row.push_back({extra, -1.0});
-          lp.addRow(row, 0, COIN_DBL_MAX);
-        }
+      for (int m = 0; m < kFrictionPyramidEdges; ++m) {
+        const double a = 2 * M_PI * (m + 0.5) / kFrictionPyramidEdges;
+        std::vector<std::pair<int, double>> row = {
+            {3 * k, corners[k].mu * inset}, {3 * k + 1, -std::cos(a)}, {3 * k + 2, -std::sin(a)}};
+        if (margin_lp) row.push_back({extra, -1.0});
+        lp.addRow(row, 0, COIN_DBL_MAX);
+      }
     return extra;
   };
 
@@ -185,6 +203,7 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     JTf += c.JT * f;
     rep.points[c.contact].push_back(c.p);
     rep.forces[c.contact].push_back(f);
+    rep.worst_cone_ratio = std::max(rep.worst_cone_ratio, coneRatio(f, c.n, c.mu, 1e-6 * W));
   }
   const Eigen::VectorXd tau = g - JTf;
   rep.residual = tau.head<6>().norm() / W;

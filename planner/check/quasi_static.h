@@ -2,10 +2,12 @@
 // Independent quasi-static feasibility check (DESIGN.md sections 6 and 9): an
 // LP over contact forces at the corners of each supporting contact, built from
 // Simbody's gravity torques and station Jacobians only. It shares no code with
-// the posture generator beyond the model, and uses the contract's friction
-// pyramid (|f_t1|, |f_t2| <= mu f_n), not the generator's inscribed one.
+// the posture generator beyond the model. Friction: the contract's pyramid
+// inscribed in the Coulomb cone (planner/scene/friction.h), by its facets
+// (the generator spans it by its edges).
 //
-// LP 1: the largest margin s such that mu f_n - |f_ti| >= s at every corner,
+// LP 1: the largest margin s such that every facet row
+//       mu cos(pi/E) f_n - t_a . f_t >= s at every corner,
 //       subject to force and moment balance and |tau_j| <= limit.
 // LP 2: the smallest worst torque ratio max_j |tau_j| / limit_j, forces in
 //       their pyramids, balance exact.
@@ -29,6 +31,7 @@ struct QuasiStaticReport {
   double worst_torque_ratio = 0;    // LP 2's optimum (<= 1 when feasible)
   std::string worst_joint;
   double residual = 0;              // |force and moment balance| / weight, at LP 2's forces
+  double worst_cone_ratio = 0;      // max ||f_t|| / (mu f_n) over LP 2's corner forces (<= 1: in the cone)
   int supporting_contacts = 0;
   // Per stance contact, in stance order: world corner points and forces (LP 2);
   // empty for a contact that does not support.
@@ -48,8 +51,9 @@ class QuasiStaticChecker {
   // dual simplex takes a few pivots instead of a solve from scratch (the
   // trajectory check of the chair: 36 s -> 17 s). The optimum (margin, torque
   // ratio) and so the verdict do not depend on the start; the forces reported
-  // may, where they are not unique (callers that use the forces, such as the
-  // bridge's ZMP reference, leave it off).
+  // may, where they are not unique: from the previous basis they follow it
+  // continuously (the bridge's ZMP reference uses it for that, computing its
+  // samples in order).
   void setWarmStart(bool on) { warm_start_ = on; }
   // On by default. Off, LP 1 is not solved and the report's margin is NaN:
   // the verdict is the same, because LP 2's forces with s = 0 are feasible

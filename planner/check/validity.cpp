@@ -47,7 +47,7 @@ CheckPart ValidityChecker::checkEquilibrium(const std::vector<ContactSpec>& stan
      << (std::isnan(q.margin) ? std::string("not computed") : fmt("%.1f", q.margin) + " N") << "; worst torque "
      << fmt("%.0f", q.worst_torque_ratio * 100) << "% of its limit ("
      << (q.worst_joint.empty() ? "-" : q.worst_joint) << "); balance residual " << fmt("%.1e", q.residual)
-     << " of the weight";
+     << " of the weight; worst ||f_t|| / (mu f_n) " << fmt("%.3f", q.worst_cone_ratio);
   p.summary = os.str();
   if (out) *out = q;
   return p;

@@ -42,6 +42,10 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
                                const PostureOptions& options)
     : robot_(std::move(robot)), scene_(std::move(scene)), collision_(std::move(collision)), req_(request),
       opt_(options), kin_(robot_) {
+  // Its edges must be edges of the contract's pyramid, or it could reach outside it.
+  if (opt_.pyramid_sides < 3 || kFrictionPyramidEdges % opt_.pyramid_sides != 0)
+    throw std::invalid_argument("pyramid_sides = " + std::to_string(opt_.pyramid_sides) + ": expected a divisor of " +
+                                std::to_string(kFrictionPyramidEdges) + " of at least 3");
   if (req_.initial_guess.joints.size() != robot_->numJoints())
     throw std::invalid_argument("initial guess has " + std::to_string(req_.initial_guess.joints.size()) +
                                 " joints, the robot " + std::to_string(robot_->numJoints()));
@@ -221,7 +225,7 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
     xl[x_float_ + 2] = req_.floating->volume.theta_min;
     xu[x_float_ + 2] = req_.floating->volume.theta_max;
   }
-  for (int c = x_lambda_; c < nx_; ++c) xl[c] = opt_.min_force_coefficient;
+  for (int c = x_lambda_; c < nx_; ++c) xl[c] = opt_.min_corner_force / opt_.pyramid_sides;
 
   gl = Eigen::VectorXd::Zero(ng_);
   gu = Eigen::VectorXd::Zero(ng_);
@@ -295,7 +299,7 @@ Eigen::VectorXd PostureProblem::initialPoint() const {
     // a few projected gradient steps toward the non-negative least-squares solution
     const double step = 1.0 / AtA.norm();
     for (int it = 0; it < 200; ++it) lam = (lam - step * (AtA * lam - A.transpose() * b)).cwiseMax(0.0);
-    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(opt_.min_force_coefficient);
+    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(opt_.min_corner_force / opt_.pyramid_sides);
   }
   return x;
 }

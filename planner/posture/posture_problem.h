@@ -4,8 +4,9 @@
 //
 // Variables x = [ configuration (tangent offset from the initial guess: base
 // translation, base rotation vector R = exp(w) R0, joints) | floating contact
-// (x, y, theta) if any | friction-pyramid coefficients lambda >= 0, 4 per
-// corner of each supporting contact, in units of the robot's weight ].
+// (x, y, theta) if any | friction-pyramid coefficients lambda >= 0, one per
+// pyramid edge (planner/scene/friction.h) at each corner of each supporting
+// contact, in units of the robot's weight ].
 //
 // Constraints (rows, in this order):
 //   contacts    6 per contact (the fixed ones, the floating one, then the pose
@@ -27,6 +28,7 @@
 
 #include "planner/collision/collision_model.h"
 #include "planner/posture/posture_cost.h"
+#include "planner/scene/friction.h"
 #include "planner/scene/scenario.h"
 
 namespace acyclic {
@@ -77,12 +79,25 @@ struct PostureRequest {
 struct PostureOptions {
   double collision_margin = 0.005;   // m
   double collision_cutoff = 0.15;    // m: pairs farther than this at the start are left out
-  int pyramid_sides = 4;             // generators per corner (inscribed friction pyramid)
+  // Generators per corner: edges of the pyramid inscribed in the cone
+  // (friction.h), a divisor of the contract's count so that they are edges
+  // of the contract's pyramid: the forces are inside the contract's pyramid
+  // and the true cone either way.
+  // 4 by default (every other edge: 0.707 mu usable in the worst direction
+  // instead of 0.924, a smaller pyramid, so more conservative). With all 8
+  // the witnesses change, and what is built on them is chaotic in them: the
+  // chair's search took 593 nodes instead of 407 and made a plan with a foot
+  // step the interpolator cannot make, two of the interpolator's narrow
+  // chair transitions failed, sit_down's OMPL guide no longer led to a plan
+  // in 300 nodes. 8 is an option (scenario posture_pyramid_edges,
+  // acyclic-interpolator --pyramid-edges, acyclic-posture --pyramid-edges).
+  int pyramid_sides = 4;
   // Margins that keep a solution strictly inside what the independent check
-  // accepts (an optimum sits on its constraints' boundary): every pyramid
-  // coefficient at least this (body weights), torques within this share of
-  // their limits.
-  double min_force_coefficient = 2e-3;
+  // accepts (an optimum sits on its constraints' boundary): each corner's
+  // pyramid coefficients at least this in all (body weights), split evenly
+  // among its edges (so the least force on a corner does not depend on how
+  // many edges span its pyramid), torques within this share of their limits.
+  double min_corner_force = 8e-3;
   double torque_share = 0.98;
   double force_regularization = 1e-4;  // small cost on lambda^2 (lambda in body weights): unique forces
 };

@@ -1,5 +1,7 @@
 #include "planner/search/planner_parameters.h"
 
+#include "planner/scene/friction.h"
+
 namespace acyclic {
 
 PlannerParameters plannerParameters(const Scenario& sc) {
@@ -9,6 +11,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
                "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
+               "posture_pyramid_edges",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -63,6 +66,13 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     const auto e = distanceEngineNamed(f["posture_distance_engine"].string());
     if (!e) f["posture_distance_engine"].fail("fcl or convex");
     p.posture.distance_engine = *e;
+  }
+  if (f.has("posture_pyramid_edges")) {
+    const int v = f["posture_pyramid_edges"].integer();
+    if (v != 4 && v != kFrictionPyramidEdges)
+      f["posture_pyramid_edges"].fail("4 or " + std::to_string(kFrictionPyramidEdges) +
+                                      " (edges of the contract's friction pyramid)");
+    p.posture.problem.pyramid_sides = v;
   }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
