@@ -10,6 +10,7 @@
 
 #include "interpolator/stance_filter.h"
 #include "interpolator/time_law.h"
+#include "planner/scene/friction.h"
 
 namespace acyclic {
 
@@ -41,6 +42,10 @@ std::string validateOptions(const InterpolatorOptions& o) {
   if (!(o.fixed_step >= 0)) return "the fixed-contact step must be non-negative";
   if (!(o.dt > 0)) return "dt must be positive";
   if (!(o.speed_cap > 0)) return "the speed cap must be positive";
+  if (o.pyramid_edges != 4 && o.pyramid_edges != kFrictionPyramidEdges)
+    return "the friction pyramid's edges must be 4 or " + std::to_string(kFrictionPyramidEdges);
+  if (!(o.link_acceleration_cap > 0 && std::isfinite(o.link_acceleration_cap)))
+    return "the link acceleration cap must be positive and finite";
   if (!(o.velocity_share > 0 && o.velocity_share <= 1)) return "the velocity share must be in (0, 1]";
   if (!(o.lift > o.touch_clearance && o.touch_clearance > 0 && o.touch_clearance < 1e-3))
     return "expected 0 < touch clearance < 1 mm and lift > touch clearance";
@@ -100,9 +105,10 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.max_iterations = opt.posture_iterations;
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
+  to.posture.problem.pyramid_sides = opt.pyramid_edges;
   to.posture.ipopt_options = opt.posture_ipopt_options;
   to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
-  to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap};
+  to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};
   to.verify_samples = opt.verify_samples;
   TransitionSolver solver(sc, to);
   Trajectory& tr = res.trajectory;
@@ -205,8 +211,8 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   pr.transition = pr.transitions;
   report("timing");
 
-  // Time each piece rest to rest; consecutive pieces with the same contacts form one phase.
-  TimeLawOptions tl{opt.dt, opt.velocity_share, opt.speed_cap};
+  // Time each piece rest to rest (time_law.h); consecutive pieces with the same contacts form one phase.
+  const TimeLawOptions& tl = to.timing;
   Kinematics kin(sc.robot);
   std::vector<TimedPiece> timed;
   std::vector<int> piece_phase, piece_start;

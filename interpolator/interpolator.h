@@ -22,6 +22,7 @@ struct InterpolatorOptions {
   double dt = 0.005;             // s, the controller's period
   double speed_cap = 0.2;        // m/s, any link origin (quasi-static motion)
   double velocity_share = 0.9;   // of each joint's velocity limit
+  double link_acceleration_cap = 1.0;  // m/s^2, any link origin (time_law.h); joints: the robot's limits
   bool filter = true;            // drop stances whose direct transition is valid
   double lift = 0.03;            // m: straight along the normal when leaving and reaching a surface
   double touch_clearance = 5e-4; // m: a body this far off its surface has left it
@@ -36,6 +37,8 @@ struct InterpolatorOptions {
   // one fails). Off, only knots and segment middles are checked: for
   // measuring what the verification costs, not for output.
   bool verify_samples = true;
+  // Edges of the knots' friction pyramid: 4 or 8 (PostureOptions::pyramid_sides).
+  int pyramid_edges = 4;
   // Each posture call bounded by iterations, not time: same input, same output.
   int posture_iterations = 100;
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out

@@ -76,6 +76,12 @@ int main(int argc, char** argv) {
   app.add_option("--dt", o.dt, "sample period, s (the controller's)")->capture_default_str();
   app.add_option("--speed-cap", o.speed_cap, "largest speed of any link origin, m/s")->capture_default_str();
   app.add_option("--velocity-share", o.velocity_share, "share of each joint's velocity limit used")->capture_default_str();
+  app.add_option("--pyramid-edges", o.pyramid_edges,
+                 "edges of the knots' friction pyramid: 4 (every other edge of the contract's) or 8 (all)")
+      ->capture_default_str();
+  app.add_option("--link-acceleration-cap", o.link_acceleration_cap,
+                 "largest acceleration of any link origin, m/s^2 (joints: the robot file's acceleration_limits)")
+      ->capture_default_str();
   app.add_option("--lift", o.lift, "straight motion along the surface normal on leaving and reaching, m")
       ->capture_default_str();
   app.add_flag("--no-filter", no_filter, "keep every stance of the plan");

@@ -250,3 +250,35 @@ TEST(Hrp2Model, ChainJacobiansMatchSimbody) {
     EXPECT_LT(test::relativeError(g.transpose(), num), 1e-6);
   }
 }
+
+// Acceleration limits: the robot file's default and per-joint overrides;
+// a bad value or an unknown joint is named with the file and the field.
+TEST(Hrp2Model, AccelerationLimitsFromTheRobotFile) {
+  for (const auto& j : hrp2()->joints()) EXPECT_EQ(j.acceleration, 4.0) << j.name;
+  const std::string yaml = test::readFile(test::sourcePath("models/hrp2/hrp2.yaml"));
+  const std::string line = "acceleration_limits: {default: 4.0}";
+  ASSERT_NE(yaml.find(line), std::string::npos);
+  auto load = [&](const std::string& replacement) {
+    test::TempDir dir;
+    std::string text = yaml;
+    text.replace(text.find(line), line.size(), replacement);
+    dir.write("hrp2.urdf", test::readFile(test::sourcePath("models/hrp2/hrp2.urdf")));
+    return RobotModel::load(dir.write("hrp2.yaml", text));
+  };
+  const auto m = load("acceleration_limits: {default: 2.5, RARM_JOINT6: 9}");
+  EXPECT_EQ(m->joints()[m->jointIndex("RARM_JOINT6")].acceleration, 9.0);
+  EXPECT_EQ(m->joints()[m->jointIndex("LLEG_JOINT3")].acceleration, 2.5);
+  EXPECT_EQ(m->accelerationLimits()[m->jointIndex("RARM_JOINT6")], 9.0);
+  for (const auto& [text, needle] : std::vector<std::pair<std::string, std::string>>{
+           {"acceleration_limits: {default: -1}", "acceleration_limits.default"},
+           {"acceleration_limits: {default: .nan}", "acceleration_limits.default"},
+           {"acceleration_limits: {RARM_JOINT9: 3}", "acceleration_limits.RARM_JOINT9"}}) {
+    try {
+      load(text);
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("hrp2.yaml"), std::string::npos) << e.what();
+    }
+  }
+}

@@ -86,10 +86,13 @@ TrajectoryReport checkTrajectory(const Trajectory& tr, const Scenario& sc, Valid
 
   // Every sample a valid posture with its phase's contacts.
   TrajectoryCheckPart samples{"samples", "", 0, {}};
+  int worst_cone_sample = -1;
   for (int i = 0; i < n; ++i) {
     const auto& s = tr.samples[i];
     if (s.phase < 0 || s.phase >= static_cast<int>(tr.phases.size())) continue;
-    const ValidityReport r = checker.checkPosture(s.q, tr.phases[s.phase].contacts);
+    QuasiStaticReport eq;
+    const ValidityReport r = checker.checkPosture(s.q, tr.phases[s.phase].contacts, &eq);
+    if (eq.worst_cone_ratio > rep.worst_cone_ratio) rep.worst_cone_ratio = eq.worst_cone_ratio, worst_cone_sample = i;
     if (!r.valid()) {
       ++rep.invalid_samples;
       for (const auto& p : r.parts)
@@ -100,7 +103,8 @@ TrajectoryReport checkTrajectory(const Trajectory& tr, const Scenario& sc, Valid
     if (progress && (i % 50 == 0 || i + 1 == n)) progress(i + 1, n);
   }
   samples.summary = std::to_string(n - rep.invalid_samples) + " of " + std::to_string(n) +
-                    " samples valid (joint limits, phase contacts within 1 mm, collisions, equilibrium)";
+                    " samples valid (joint limits, phase contacts within 1 mm, collisions, equilibrium)" +
+                    fmt("; worst ||f_t|| / (mu f_n) %.3f (sample %.0f)", rep.worst_cone_ratio, worst_cone_sample);
 
   // Joint velocity limits: the stored velocities and the finite differences of the positions.
   TrajectoryCheckPart vel{"velocity limits", "", 0, {}};
@@ -128,6 +132,47 @@ TrajectoryReport checkTrajectory(const Trajectory& tr, const Scenario& sc, Valid
   vel.summary = fmt("worst joint speed %.0f%% of its limit", rep.worst_velocity_ratio * 100) +
                 (worst_joint.empty() ? "" : " (" + worst_joint + ")");
 
+  // The stored velocities are the positions' derivative: over each interval
+  // their mean (the trapezoid rule) matches the positions' difference.
+  TrajectoryCheckPart consistent{"velocities from positions", "", 0, {}};
+  std::string worst_consistent_joint;
+  for (int i = 0; i + 1 < n && tr.dt > 0; ++i) {
+    const auto& a = tr.samples[i];
+    const auto& b = tr.samples[i + 1];
+    if (a.dq.size() != robot.numJoints() || b.dq.size() != robot.numJoints()) continue;  // reported above
+    for (const auto& j : robot.joints()) {
+      const double fd = (b.q.joints[j.index] - a.q.joints[j.index]) / tr.dt;
+      const double mean = 0.5 * (a.dq[j.index] + b.dq[j.index]);
+      const double r = std::abs(fd - mean) / (j.acceleration * tr.dt);
+      if (r > rep.worst_consistency) rep.worst_consistency = r, worst_consistent_joint = j.name;
+      if (!(r <= opt.consistency))
+        add(consistent, j.name + fmt(" between samples %.0f and %.0f: stored velocities %.4f rad/s on average, ", i, i + 1, mean) +
+                            fmt("positions %.4f rad/s", fd),
+            opt.max_violations);
+    }
+  }
+  consistent.summary = fmt("stored velocities against positions: worst gap %.2f of a * dt (tolerance %.2f)",
+                           rep.worst_consistency, opt.consistency) +
+                       (worst_consistent_joint.empty() ? "" : " (" + worst_consistent_joint + ")");
+
+  // Accelerations from positions: the second difference over dt^2.
+  TrajectoryCheckPart accel{"acceleration limits", "", 0, {}};
+  std::string worst_accel_joint;
+  for (int i = 1; i + 1 < n && tr.dt > 0; ++i) {
+    for (const auto& j : robot.joints()) {
+      const double a = (tr.samples[i + 1].q.joints[j.index] - 2 * tr.samples[i].q.joints[j.index] +
+                        tr.samples[i - 1].q.joints[j.index]) /
+                       (tr.dt * tr.dt);
+      const double r = std::abs(a) / j.acceleration;
+      if (r > rep.worst_acceleration_ratio) rep.worst_acceleration_ratio = r, worst_accel_joint = j.name;
+      if (!(r <= 1 + opt.acceleration_tolerance))
+        add(accel, j.name + fmt(" at sample %.0f: %.2f rad/s^2 over its limit %.2f rad/s^2", i, std::abs(a), j.acceleration),
+            opt.max_violations);
+    }
+  }
+  accel.summary = fmt("from positions: worst joint acceleration %.0f%% of its limit", rep.worst_acceleration_ratio * 100) +
+                  (worst_accel_joint.empty() ? "" : " (" + worst_accel_joint + ")");
+
   // Zero velocity where a contact is made or broken: at the sample on each such phase boundary.
   TrajectoryCheckPart rest{"rest at contact changes", "", 0, {}};
   int boundaries = 0;
@@ -145,10 +190,25 @@ TrajectoryReport checkTrajectory(const Trajectory& tr, const Scenario& sc, Valid
       add(rest, fmt("sample %.0f (t = %.4f s, contact change into phase %.0f): ", i, tb, k) +
                     fmt("joint speed %.3g rad/s, not zero", v),
           opt.max_violations);
+    // At rest as the positions show it: the samples on either side barely move.
+    for (int other : {i - 1, i + 1}) {
+      if (other < 0 || other >= n) continue;
+      for (const auto& j : robot.joints()) {
+        const double d = std::abs(tr.samples[other].q.joints[j.index] - tr.samples[i].q.joints[j.index]);
+        const double allowed = opt.rest_displacement * j.acceleration * tr.dt * tr.dt;
+        if (d > allowed * (1 + 1e-9) + 1e-12) {
+          add(rest, fmt("sample %.0f (t = %.4f s, contact change into phase %.0f): ", i, tb, k) + j.name +
+                        fmt(" moves %.3g mrad to sample %.0f, at rest it could move %.3g mrad", d * 1e3, other, allowed * 1e3),
+              opt.max_violations);
+          break;
+        }
+      }
+    }
   }
-  rest.summary = std::to_string(boundaries) + " contacts made or broken, velocity zero at each";
+  rest.summary = std::to_string(boundaries) +
+                 " contacts made or broken, at rest at each (stored velocity zero, neighbouring samples still)";
 
-  rep.parts = {samples, vel, rest, phases};
+  rep.parts = {samples, vel, consistent, accel, rest, phases};
   return rep;
 }
 

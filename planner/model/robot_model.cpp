@@ -75,7 +75,7 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
   YamlField root = YamlField::loadFile(yaml_path);
   root.requireFormat("acyclic.robot/1");
   root.allowOnly({"format", "name", "urdf", "base_link", "controller_order", "contact_spots",
-                  "self_collision_pairs", "postures"});
+                  "self_collision_pairs", "postures", "acceleration_limits"});
   std::shared_ptr<RobotModel> m(new RobotModel());
   m->yaml_path_ = yaml_path;
   m->urdf_path_ = (fs::path(yaml_path).parent_path() / root["urdf"].string()).string();
@@ -141,6 +141,26 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
   for (const auto& [name, uj] : urdf->joints_)
     if (!seen.count(name))
       throw FormatError(yaml_path, "controller_order", "every joint of the URDF; missing " + name);
+
+  // Acceleration limits: `default` and any joint by name, rad/s^2.
+  for (auto& j : m->joints_) j.acceleration = kDefaultJointAcceleration;
+  if (root.has("acceleration_limits")) {
+    const YamlField acc = root["acceleration_limits"];
+    if (!acc.isMap()) acc.fail("a map of joint names (or default) to rad/s^2");
+    auto value = [](const YamlField& f) {
+      const double a = f.number();
+      if (!(a > 0 && a <= 1e4)) f.fail("an acceleration in (0, 10000] rad/s^2");
+      return a;
+    };
+    if (acc.has("default"))
+      for (auto& j : m->joints_) j.acceleration = value(acc["default"]);
+    for (const std::string& k : acc.keys()) {
+      if (k == "default") continue;
+      const int ji = m->jointIndex(k);
+      if (ji < 0) acc[k].fail("a joint of the robot (or default)");
+      m->joints_[ji].acceleration = value(acc[k]);
+    }
+  }
 
   // Tree structure: which joints move which links.
   m->ancestors_.assign(m->links_.size(), {});
@@ -293,6 +313,7 @@ double RobotModel::totalMass() const {
 ACYCLIC_LIMIT_VECTOR(lowerLimits, lower)
 ACYCLIC_LIMIT_VECTOR(upperLimits, upper)
 ACYCLIC_LIMIT_VECTOR(velocityLimits, velocity)
+ACYCLIC_LIMIT_VECTOR(accelerationLimits, acceleration)
 ACYCLIC_LIMIT_VECTOR(effortLimits, effort)
 #undef ACYCLIC_LIMIT_VECTOR
 

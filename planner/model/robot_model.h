@@ -30,7 +30,17 @@ struct JointInfo {
   double lower = 0, upper = 0;   // rad
   double velocity = 0;       // rad/s
   double effort = 0;         // N m
+  // rad/s^2: what a trajectory may ask of the joint (the time law keeps under
+  // it; the trajectory check measures it from positions). The robot file's
+  // acceleration_limits, kDefaultJointAcceleration where it says nothing.
+  double acceleration = 0;
 };
+
+// HRP-2's public facts give no acceleration limit. 4 rad/s^2 is an
+// engineering figure: a joint reaches its velocity limit (about 4 rad/s) in a
+// second, and a link a metre out accelerates at 0.4 g at most (the time law's
+// link cap keeps whole-body motions far gentler, quasi-static).
+constexpr double kDefaultJointAcceleration = 4.0;
 
 struct CollisionShape {
   enum class Kind { Box, Capsule, Sphere, Cylinder };
@@ -98,6 +108,7 @@ class RobotModel {
   Eigen::VectorXd lowerLimits() const;
   Eigen::VectorXd upperLimits() const;
   Eigen::VectorXd velocityLimits() const;
+  Eigen::VectorXd accelerationLimits() const;
   Eigen::VectorXd effortLimits() const;
 
   // Reads a configuration from YAML: optional `posture` (a named posture to
