@@ -110,16 +110,16 @@ double YamlField::angle() const {
   return v;
 }
 
-double YamlField::angleDeg() const {
+double YamlField::degrees() const {
   const double v = number();
   if (std::abs(v) > 720) fail("an angle in degrees within +-720");
-  return v * M_PI / 180;
+  return v;
 }
 
 Eigen::Vector3d YamlField::angles3(bool degrees) const {
   if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 angles");
   Eigen::Vector3d a;
-  for (int i = 0; i < 3; ++i) a[i] = degrees ? at(i).angleDeg() : at(i).angle();
+  for (int i = 0; i < 3; ++i) a[i] = degrees ? at(i).degrees() : at(i).angle();
   return a;
 }
 
@@ -204,7 +204,7 @@ Eigen::Quaterniond readOrientation(const YamlField& parent) {
     throw FormatError(parent.file(), parent.path(),
                       "give at most one of rpy, rpy_deg, quaternion");
   if (parent.has("rpy")) return rpyToQuaternion(parent["rpy"].angles3(false));
-  if (parent.has("rpy_deg")) return rpyToQuaternion(parent["rpy_deg"].angles3(true));
+  if (parent.has("rpy_deg")) return rpyToQuaternion(parent["rpy_deg"].angles3(true) * M_PI / 180.0);
   if (parent.has("quaternion")) {
     auto v = parent["quaternion"].numbers(4);
     Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);

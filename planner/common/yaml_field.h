@@ -40,11 +40,12 @@ class YamlField {
   // A finite number of plausible magnitude (|x| <= 1e9): a non-finite or
   // absurd value is bad input, named with its file and field.
   double number() const;
-  // An angle in radians (|a| <= 4 pi), or in degrees converted to radians
-  // (|a| <= 720): any orientation or joint angle is within that.
+  // An angle in radians (|a| <= 4 pi), or in degrees (|a| <= 720, returned
+  // in degrees: the caller converts as it always did, bit for bit): any
+  // orientation or joint angle is within that.
   double angle() const;
-  double angleDeg() const;
-  Eigen::Vector3d angles3(bool degrees) const;  // [a, b, c], in radians
+  double degrees() const;
+  Eigen::Vector3d angles3(bool degrees) const;  // [a, b, c], in the unit asked for
   int integer() const;
   bool boolean() const;
   std::string string() const;
