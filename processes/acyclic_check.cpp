@@ -11,6 +11,7 @@
 #include "planner/check/trajectory_check.h"
 #include "planner/common/format_error.h"
 #include "planner/scene/scenario.h"
+#include "planner/search/planner_parameters.h"
 
 namespace {
 
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
 
   try {
     const acyclic::Scenario sc = acyclic::Scenario::load(scenario_path);
+    acyclic::plannerParameters(sc);  // its planner section, read as the planner reads it (bad input: exit 2)
     std::printf("acyclic-check: scenario %s (%s)\n", sc.name.c_str(), scenario_path.c_str());
     std::printf("  robot %s: %d joints, %d links, %zu contact spots, %.2f kg\n", sc.robot->name().c_str(),
                 sc.robot->numJoints(), sc.robot->numLinks(), sc.robot->spots().size(), sc.robot->totalMass());

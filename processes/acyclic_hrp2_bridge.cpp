@@ -186,7 +186,14 @@ int main(int argc, char** argv) {
     checks.emplace_back(std::thread([&, id, done, tr = std::move(tr)] {
       hrp2::setBackgroundPriority(rt_priority > 0);
       const std::int64_t t0 = hrp2::monotonicMicros();
-      hrp2::PrepareResult r = hrp2::prepareChecked(tr, sc, cfg, popt);
+      hrp2::PrepareResult r;
+      try {
+        r = hrp2::prepareChecked(tr, sc, cfg, popt);
+      } catch (const std::exception& e) {
+        // A check that fails is a refusal, never the end of the bridge.
+        r = hrp2::PrepareResult{};
+        r.check = hrp2::CheckResult::failure(std::string("the check failed: ") + e.what());
+      }
       char took[120];
       std::snprintf(took, sizeof took, "request %lld checked in %.2f s (%zu samples%s)", static_cast<long long>(id),
                     (hrp2::monotonicMicros() - t0) * 1e-6, tr.samples.size(),
@@ -204,10 +211,7 @@ int main(int argc, char** argv) {
   auto h_state = subscribe(*bus, channels::kHrp2State, [&](const lcm::ReceiveBuffer* rb) {
     const std::int64_t now = hrp2::monotonicMicros();
     hrp2_state_t m;
-    if (m.decode(rb->data, 0, static_cast<int>(rb->data_size)) < 0) {
-      status.error(-1, std::string(channels::kHrp2State) + ": a message that does not decode");
-      return;
-    }
+    if (!proc::decode(rb, channels::kHrp2State, m, status)) return;
     hrp2::MeasuredState s;
     // A wrong joint count is passed on as it is: the bridge refuses it (fault while streaming).
     s.q = Eigen::Map<const Eigen::VectorXd>(m.q.data(), static_cast<Eigen::Index>(m.q.size()));
@@ -221,9 +225,10 @@ int main(int argc, char** argv) {
   });
   auto h_estop = subscribe(*bus, channels::kHrp2Estop, [&](const lcm::ReceiveBuffer* rb) {
     hrp2_estop_t m;
-    if (m.decode(rb->data, 0, static_cast<int>(rb->data_size)) < 0) {
-      // An e-stop that does not decode is still an e-stop: freeze.
-      status.error(-1, std::string(channels::kHrp2Estop) + ": a message that does not decode: engaging");
+    // An e-stop that does not decode is still an e-stop: freeze.
+    static const std::string channel = std::string(channels::kHrp2Estop) + " (engaging)";
+    if (!proc::decode(rb, channel, m, status)) {
+      m = hrp2_estop_t{};
       m.engage = true;
       m.source = "undecodable message";
     }
@@ -244,10 +249,7 @@ int main(int argc, char** argv) {
   });
   auto takeTrajectory = [&](const std::vector<char>& bytes) {
     trajectory_t m;
-    if (m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0) {
-      status.error(-1, std::string(channels::kTrajectory) + ": a message that does not decode");
-      return;
-    }
+    if (!proc::decode(bytes.data(), bytes.size(), channels::kTrajectory, m, status)) return;
     if (m.status != trajectory_t::OK) {
       proc::log(kName, "request " + std::to_string(m.request_id) + ": no trajectory (" + m.reason + "): nothing to do");
       return;
@@ -266,11 +268,19 @@ int main(int argc, char** argv) {
 
   std::atomic<bool> lcm_failed{false}, quit{false};
   std::thread receiver([&] {
-    while (!proc::stopRequested() && !quit)
-      if (bus->lcm().handleTimeout(20) < 0 && !proc::stopRequested()) {
+    while (!proc::stopRequested() && !quit) {
+      int r = 0;
+      try {
+        r = bus->lcm().handleTimeout(20);
+      } catch (const std::exception& e) {
+        // A handler's failure is one message lost, never the bridge.
+        status.error(-1, std::string("a message's handler failed: ") + e.what());
+      }
+      if (r < 0 && !proc::stopRequested()) {
         lcm_failed = true;
         break;
       }
+    }
   });
   std::thread intake_thread([&] {
     hrp2::setBackgroundPriority(rt_priority > 0);
@@ -281,7 +291,11 @@ int main(int argc, char** argv) {
         std::vector<char> bytes = std::move(intake.front());
         intake.pop_front();
         lock.unlock();
-        takeTrajectory(bytes);
+        try {
+          takeTrajectory(bytes);
+        } catch (const std::exception& e) {
+          status.error(-1, std::string(channels::kTrajectory) + ": a trajectory's intake failed: " + e.what());
+        }
         lock.lock();
       }
     }

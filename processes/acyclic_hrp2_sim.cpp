@@ -54,7 +54,10 @@ int main(int argc, char** argv) {
       "A simulated HRP-2 controller: subscribes HRP2_COMMAND, tracks it with position-controlled joints\n"
       "(first-order law with velocity feed-forward, within the model's velocity limits; the base follows\n"
       "the streamed waist reference), publishes HRP2_STATE at the controller rate with contact wrenches\n"
-      "from the quasi-static model. A command of the wrong size or with a NaN is ignored and counted.\n"
+      "from the quasi-static model. A command of the wrong size or with a NaN is ignored and counted; like a\n"
+      "real controller it refuses (and counts) a command beyond the joint position or velocity limits and\n"
+      "never moves a joint past its limits (joints are kinematic: no torques, so no torque limit); when the\n"
+      "command stream stops for --hold-after-missed periods it holds the last commanded posture.\n"
       "Exit status: 0 on SIGINT/SIGTERM or after --duration, 2 bad input, 3 LCM failure."};
   std::string scenario_path, start_trajectory, url = proc::defaultLcmUrl();
   hrp2::SimOptions o;
@@ -76,6 +79,10 @@ int main(int argc, char** argv) {
                  "contact wrenches (quasi-static LP, off the control loop) every this many s (default 0.05)")
       ->check(CLI::PositiveNumber);
   app.add_flag("--servo-off", servo_off, "report the servos off (the bridge must refuse to start)");
+  app.add_option("--hold-after-missed", o.hold_after_missed,
+                 "hold the last commanded posture (no velocity feed-forward, the base where it stands) after this\n"
+                 "many periods without HRP2_COMMAND, once commands have come (the bridge died or hangs); 0: never\n"
+                 "(default 20: 0.1 s at 5 ms)");
   app.add_option("--duration", duration, "exit after this many seconds (default: run until a signal)");
   app.add_option("--rt-priority", rt_priority,
                  "SCHED_FIFO priority of the control loop and LCM receive threads, 0: none (default 20; when not\n"
@@ -120,11 +127,11 @@ int main(int argc, char** argv) {
   } on_command{[&](const lcm::ReceiveBuffer* rb) {
     const std::int64_t now = hrp2::monotonicMicros();
     hrp2_command_t m;
-    if (m.decode(rb->data, 0, static_cast<int>(rb->data_size)) < 0 || m.num_joints != n) {
+    if (!proc::decode(rb, channels::kHrp2Command, m, status)) return;
+    if (m.num_joints != n) {
       if (bad_messages++ == 0)
-        status.error(-1, std::string(channels::kHrp2Command) + ": a command that does not decode or has " +
-                             std::to_string(m.num_joints) + " joints (the robot has " + std::to_string(n) +
-                             "): ignored (counted from now on)");
+        status.error(-1, std::string(channels::kHrp2Command) + ": a command for " + std::to_string(m.num_joints) +
+                             " joints (the robot has " + std::to_string(n) + "): ignored (counted from now on)");
       return;
     }
     hrp2::SimCommand c;
@@ -141,11 +148,18 @@ int main(int argc, char** argv) {
 
   std::atomic<bool> lcm_failed{false}, quit{false};
   std::thread receiver([&] {
-    while (!proc::stopRequested() && !quit)
-      if (bus->lcm().handleTimeout(20) < 0 && !proc::stopRequested()) {
+    while (!proc::stopRequested() && !quit) {
+      int r = 0;
+      try {
+        r = bus->lcm().handleTimeout(20);
+      } catch (const std::exception& e) {
+        status.error(-1, std::string("a message's handler failed: ") + e.what());
+      }
+      if (r < 0 && !proc::stopRequested()) {
         lcm_failed = true;
         break;
       }
+    }
   });
   // Contact wrenches: the LP takes milliseconds, so it runs on its own thread
   // at its own rate and the control loop attaches the latest result.
@@ -178,7 +192,9 @@ int main(int argc, char** argv) {
   status.idle();
   hrp2::PeriodicLoop loop(o.dt);
   const std::int64_t t0 = hrp2::monotonicMicros();
-  bool announced_freeze = false;
+  bool announced_freeze = false, holding_missed = false;
+  long refused_reported = 0;
+  std::int64_t refused_reported_at = 0;
   while (!proc::stopRequested() && !lcm_failed) {
     const std::int64_t now = loop.wait();
     if (duration > 0 && now - t0 >= duration * 1e6) break;
@@ -199,6 +215,25 @@ int main(int argc, char** argv) {
       }
     }
     if (msg) bus->publish(channels::kHrp2State, *msg);
+    bool holding_now;
+    long refused;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      holding_now = sim->holdingForMissedCommands();
+      refused = sim->refusedPosition() + sim->refusedVelocity();
+    }
+    if (holding_now && !holding_missed)
+      proc::log(kName, "no HRP2_COMMAND for " + std::to_string(o.hold_after_missed) +
+                           " periods: holding the last commanded posture");
+    holding_missed = holding_now;
+    if (refused > refused_reported && now - refused_reported_at >= 1000000) {  // once a second at most
+      refused_reported_at = now;
+      std::lock_guard<std::mutex> lock(mutex);
+      status.error(-1, std::string(channels::kHrp2Command) + ": refused " + std::to_string(refused - refused_reported) +
+                           " command(s) beyond the joint limits (" + std::to_string(sim->refusedPosition()) +
+                           " position, " + std::to_string(sim->refusedVelocity()) + " velocity so far)");
+      refused_reported = refused;
+    }
     status.tick();
   }
   quit = true;
@@ -207,6 +242,10 @@ int main(int argc, char** argv) {
   status.stopping();
   proc::log(kName, "commands: " + std::to_string(sim->received()) + " received, " + std::to_string(sim->applied()) +
                        " applied, " + std::to_string(sim->dropped()) + " dropped, " + std::to_string(sim->rejected()) +
-                       " rejected, " + std::to_string(bad_messages) + " malformed");
+                       " rejected, " + std::to_string(bad_messages) + " of the wrong size, " +
+                       std::to_string(status.undecodableCount()) + " not decoded, " +
+                       std::to_string(sim->refusedPosition()) + " beyond position limits, " +
+                       std::to_string(sim->refusedVelocity()) + " beyond velocity limits, " +
+                       std::to_string(sim->missedHolds()) + " holds for missed commands");
   return lcm_failed ? 3 : 0;
 }

@@ -40,8 +40,11 @@ void say(const std::string& s) {
   std::fflush(stdout);
 }
 
-// What the launcher hears on LCM.
+// What the launcher hears on LCM. Every message goes through proc::decode:
+// one that does not decode is counted and reported, never the launcher's end.
 struct Listener {
+  explicit Listener(proc::StatusReporter& s) : status(s) {}
+  proc::StatusReporter& status;
   std::int64_t request_id = 0;
   std::map<std::string, int> status_seen;  // process -> status messages since (re)start
   std::optional<plan_t> plan;
@@ -49,30 +52,41 @@ struct Listener {
   std::optional<hrp2_bridge_status_t> played;   // the bridge's last status about our request
   bool tty = false;
 
-  void onStatus(const lcm::ReceiveBuffer* rb, const std::string&, const process_status_t* m) {
-    ++status_seen[m->process];
-    if (m->state == process_status_t::ERROR)
-      say(m->process + " reports an error" +
-          (m->request_id >= 0 ? " on request " + std::to_string(m->request_id) : std::string()) + ": " + m->reason);
+  void onStatus(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    process_status_t m;
+    if (!proc::decode(rb, channel, m, status)) return;
+    if (m.pid == getpid()) return;  // its own reports (already said)
+    ++status_seen[m.process];
+    if (m.state == process_status_t::ERROR)
+      say(m.process + " reports an error" +
+          (m.request_id >= 0 ? " on request " + std::to_string(m.request_id) : std::string()) + ": " + m.reason);
   }
-  void onProgress(const lcm::ReceiveBuffer*, const std::string&, const progress_t* m) {
-    if (m->request_id != request_id || !tty) return;
-    std::fprintf(stderr, "\r%s %s: %6.1f s  nodes %ld  posture calls %ld  best %.3f  %s   ", m->source.c_str(),
-                 m->stage.c_str(), m->elapsed_s, static_cast<long>(m->nodes_generated),
-                 static_cast<long>(m->posture_calls), m->best_potential, m->message.c_str());
+  void onProgress(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    progress_t m;
+    if (!proc::decode(rb, channel, m, status)) return;
+    if (m.request_id != request_id || !tty) return;
+    std::fprintf(stderr, "\r%s %s: %6.1f s  nodes %ld  posture calls %ld  best %.3f  %s   ", m.source.c_str(),
+                 m.stage.c_str(), m.elapsed_s, static_cast<long>(m.nodes_generated),
+                 static_cast<long>(m.posture_calls), m.best_potential, m.message.c_str());
   }
-  void onPlan(const lcm::ReceiveBuffer*, const std::string&, const plan_t* m) {
-    if (m->request_id == request_id) plan = *m;
+  void onPlan(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    plan_t m;
+    if (!proc::decode(rb, channel, m, status)) return;
+    if (m.request_id == request_id) plan = std::move(m);
   }
-  void onTrajectory(const lcm::ReceiveBuffer*, const std::string&, const trajectory_t* m) {
-    if (m->request_id == request_id) trajectory = *m;
+  void onTrajectory(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    trajectory_t m;
+    if (!proc::decode(rb, channel, m, status)) return;
+    if (m.request_id == request_id) trajectory = std::move(m);
   }
-  void onBridge(const lcm::ReceiveBuffer*, const std::string&, const hrp2_bridge_status_t* m) {
-    if (m->request_id != request_id) return;
-    played = *m;
-    if (tty && m->state == hrp2_bridge_status_t::STREAMING)
+  void onBridge(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    hrp2_bridge_status_t m;
+    if (!proc::decode(rb, channel, m, status)) return;
+    if (m.request_id != request_id) return;
+    played = m;
+    if (tty && m.state == hrp2_bridge_status_t::STREAMING)
       std::fprintf(stderr, "\racyclic-hrp2-bridge: streaming %5.1f %%  commands %ld  worst tracking error %.4f rad   ",
-                   100 * m->progress, static_cast<long>(m->commands_sent), m->tracking_error_max);
+                   100 * m.progress, static_cast<long>(m.commands_sent), m.tracking_error_max);
   }
 };
 
@@ -87,7 +101,8 @@ int main(int argc, char** argv) {
       "and one log per process; then plays\n"
       "the trajectory through acyclic-hrp2-bridge on acyclic-hrp2-sim (the simulated controller) and\n"
       "reports the tracking error and any safety event (--no-execute: stop at the trajectory).\n"
-      "A process that dies is restarted (3 times at most) and given again the work it lost.\n"
+      "A process that dies is restarted (3 times at most) and given again the work it lost; one that\n"
+      "cannot be restarted fails the run at once (exit status 1, with the reason).\n"
       "Everything started is stopped on exit and on Ctrl-C.\n"
       "Exit status: 0 every stage answered OK, 1 a stage failed or timed out, 2 bad input.\n"
       "Multicast: run it inside a private network namespace (scripts/run-pipeline does) or on a lab\n"
@@ -146,7 +161,8 @@ int main(int argc, char** argv) {
   int rc = 1;
   try {
     proc::Bus bus(url);
-    Listener ear;
+    proc::StatusReporter own_status(bus, "acyclic-launch");
+    Listener ear(own_status);
     ear.request_id = request_id;
     ear.tty = !quiet && isatty(STDERR_FILENO);
     bus.lcm().subscribe(channels::kStatus, &Listener::onStatus, &ear);
@@ -199,12 +215,19 @@ int main(int argc, char** argv) {
     double play_deadline = 0;
     while (!proc::stopRequested() && !done && !failed) {
       bus.lcm().handleTimeout(50);
-      for (const auto& name : sup.poll()) {
+      std::vector<std::string> gone;
+      for (const auto& name : sup.poll(&gone)) {
         ear.status_seen[name] = 0;  // wait for the new instance's first status
         // The request again: the planner lost it. (A guide author that dies
         // leaves the planner waiting; the planner then answers with the reason.)
         if (name == "acyclic-planner" && request_sent && !ear.plan) request_sent = false;
         if (name == "acyclic-interpolator" && ear.plan && !ear.trajectory && !trajectory_written) lost_work_plan = true;
+      }
+      if (!gone.empty()) {
+        // A stage that cannot be restarted fails the run now: waiting for its answer would last the whole timeout.
+        say("failed: " + gone.front() + " (see its log in " + out_dir + ")");
+        failed = true;
+        break;
       }
       if (elapsed() > timeout_s) {
         say("timed out after " + std::to_string(static_cast<int>(timeout_s)) + " s");

@@ -11,6 +11,7 @@
 
 #include "processes/command_line.h"
 #include "acyclic/progress_t.hpp"
+#include "processes/guarded_decode.h"
 #include "lcmtypes/channels.hpp"
 #include "planner/common/format_error.h"
 #include "viewer/plot/figures.h"
@@ -29,9 +30,10 @@ std::vector<PlannerProgressPoint> readProgress(const std::string& path, const st
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     if (ev->channel != channels::kProgress) continue;
     acyclic::progress_t m;
-    if (m.decode(ev->data, 0, ev->datalen) < 0)
-      throw FormatError(path, "event " + std::to_string(ev->eventnum), "a progress_t message on " +
-                                                                             std::string(channels::kProgress));
+    const std::string why = proc::whyNotDecoded(ev->data, static_cast<std::size_t>(ev->datalen), m);
+    if (!why.empty())
+      throw FormatError(path, "event " + std::to_string(ev->eventnum),
+                        "a progress_t message on " + std::string(channels::kProgress) + " (" + why + ")");
     if (m.source != source) continue;
     out.push_back({m.elapsed_s, static_cast<long>(m.nodes_generated), static_cast<long>(m.posture_calls),
                    m.best_potential});

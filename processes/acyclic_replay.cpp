@@ -8,6 +8,7 @@
 // is a regression.
 // Exit: 0 identical, 1 a difference or no answer, 2 bad input.
 #include <CLI/CLI.hpp>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -47,21 +48,39 @@ std::vector<char> canonical(Msg m) {
   return b;
 }
 
+// Every message heard goes through proc::decode: one that does not decode is
+// counted and reported, never the replay's end.
 struct Ear {
+  explicit Ear(proc::StatusReporter& s) : status(s) {}
+  proc::StatusReporter& status;
   std::map<std::string, int> status_seen;
   std::optional<plan_t> plan;
   std::optional<trajectory_t> trajectory;
   std::int64_t want = -1;
-  void onStatus(const lcm::ReceiveBuffer*, const std::string&, const process_status_t* m) {
-    ++status_seen[m->process];
+  void onStatus(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    process_status_t m;
+    if (proc::decode(rb, channel, m, status) && m.pid != getpid()) ++status_seen[m.process];
   }
-  void onPlan(const lcm::ReceiveBuffer*, const std::string&, const plan_t* m) {
-    if (m->request_id == want) plan = *m;
+  void onPlan(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    plan_t m;
+    if (proc::decode(rb, channel, m, status) && m.request_id == want) plan = std::move(m);
   }
-  void onTrajectory(const lcm::ReceiveBuffer*, const std::string&, const trajectory_t* m) {
-    if (m->request_id == want) trajectory = *m;
+  void onTrajectory(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    trajectory_t m;
+    if (proc::decode(rb, channel, m, status) && m.request_id == want) trajectory = std::move(m);
   }
 };
+
+// A logged event decoded as Msg; one that does not decode is said and skipped.
+template <class Msg>
+bool fromLog(const lcm::LogEvent* e, Msg& m, int& skipped) {
+  const std::string why = proc::whyNotDecoded(e->data, static_cast<std::size_t>(e->datalen), m);
+  if (why.empty()) return true;
+  ++skipped;
+  say("event " + std::to_string(e->eventnum) + " on " + e->channel + " does not decode as " + Msg::getTypeName() +
+      ": " + why + ": skipped");
+  return false;
+}
 
 }  // namespace
 
@@ -83,6 +102,7 @@ int main(int argc, char** argv) {
   std::vector<request_t> requests;
   std::map<std::int64_t, plan_t> plans;
   std::map<std::int64_t, trajectory_t> trajectories;
+  int skipped = 0;  // logged events that do not decode
   {
     lcm::LogFile log(log_path, "r");
     if (!log.good()) {
@@ -93,18 +113,19 @@ int main(int argc, char** argv) {
     while ((e = log.readNextEvent())) {
       if (e->channel == channels::kRequest) {
         request_t m;
-        if (m.decode(e->data, 0, e->datalen) >= 0) requests.push_back(m);
+        if (fromLog(e, m, skipped)) requests.push_back(m);
       } else if (e->channel == channels::kPlan) {
         plan_t m;
-        if (m.decode(e->data, 0, e->datalen) >= 0) plans[m.request_id] = m;
+        if (fromLog(e, m, skipped)) plans[m.request_id] = m;
       } else if (e->channel == channels::kTrajectory) {
         trajectory_t m;
-        if (m.decode(e->data, 0, e->datalen) >= 0) trajectories[m.request_id] = m;
+        if (fromLog(e, m, skipped)) trajectories[m.request_id] = m;
       }
     }
   }
   say(log_path + ": " + std::to_string(requests.size()) + " requests, " + std::to_string(plans.size()) +
-      " plans, " + std::to_string(trajectories.size()) + " trajectories");
+      " plans, " + std::to_string(trajectories.size()) + " trajectories" +
+      (skipped > 0 ? ", " + std::to_string(skipped) + " events that do not decode (skipped)" : ""));
   if (requests.empty()) {
     std::fprintf(stderr, "acyclic-replay: %s: no ACYCLIC_REQUEST to replay\n", log_path.c_str());
     return 2;
@@ -114,7 +135,8 @@ int main(int argc, char** argv) {
   int differences = 0;
   try {
     proc::Bus bus(url);
-    Ear ear;
+    proc::StatusReporter own_status(bus, "acyclic-replay");
+    Ear ear(own_status);
     bus.lcm().subscribe(channels::kStatus, &Ear::onStatus, &ear);
     bus.lcm().subscribe(channels::kPlan, &Ear::onPlan, &ear);
     bus.lcm().subscribe(channels::kTrajectory, &Ear::onTrajectory, &ear);

@@ -93,6 +93,7 @@ class GuideService : public proc::Service {
         m.reason = e.what();
         status_.error(id, e.what());
       }
+      if (worker_.abandoned()) return;  // stopping: no answer for unfinished work
       answer(m);
       status_.served();
       status_.idle();

@@ -105,6 +105,7 @@ class InterpolatorService : public proc::Service {
       }
       out.utime = proc::nowMicros();
       out.request_id = id;
+      if (worker_.abandoned()) return;  // stopping: no answer for unfinished work
       bus_.publish(channels::kTrajectory, out);
       status_.served();
       status_.idle();

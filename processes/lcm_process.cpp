@@ -106,6 +106,28 @@ void StatusReporter::error(std::int64_t request_id, const std::string& reason) {
   bus_.publish(channels::kStatus, e);
 }
 
+void StatusReporter::undecodable(const std::string& channel, const std::string& what) {
+  const std::int64_t total = ++undecodable_;
+  std::int64_t unreported = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::int64_t now = nowMicros();
+    if (now - undecodable_window_us_ >= 1000000) {
+      undecodable_window_us_ = now;
+      undecodable_in_window_ = 0;
+    }
+    if (++undecodable_in_window_ > 10) {
+      ++undecodable_unreported_;
+      ++errors_;
+      return;
+    }
+    unreported = undecodable_unreported_;
+    undecodable_unreported_ = 0;
+  }
+  error(-1, channel + ": " + what + " (" + std::to_string(total) + " refused so far" +
+                (unreported > 0 ? ", " + std::to_string(unreported) + " of them not reported one by one" : "") + ")");
+}
+
 void StatusReporter::stopping() {
   std::lock_guard<std::mutex> lock(mutex_);
   msg_.state = process_status_t::STOPPING;
@@ -118,11 +140,19 @@ void StatusReporter::tick() {
   if (nowMicros() - last_publish_us_ >= 1000000) publish();
 }
 
-int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<bool()>& done, int period_ms) {
+int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<bool()>& done, int period_ms,
+         const std::function<void(const std::string&)>& on_handler_error) {
   while (!stopRequested() && !(done && done())) {
     // handleTimeout returns < 0 on error (and, in LCM 1.3.1, when interrupted
     // by a signal: then the stop flag is set and the loop ends).
-    if (bus.lcm().handleTimeout(period_ms) < 0 && !stopRequested()) return 1;
+    int r = 0;
+    try {
+      r = bus.lcm().handleTimeout(period_ms);
+    } catch (const std::exception& e) {
+      if (!on_handler_error) throw;
+      on_handler_error(e.what());
+    }
+    if (r < 0 && !stopRequested()) return 1;
     if (on_tick) on_tick();
   }
   return 0;
@@ -155,6 +185,7 @@ void Worker::reap() {
 }
 
 void Worker::stop() {
+  abandoned_ = true;
   cancel_ = true;
   if (thread_.joinable()) thread_.join();
   running_ = false;

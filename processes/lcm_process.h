@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "acyclic/process_status_t.hpp"
+#include "processes/guarded_decode.h"
 
 namespace acyclic::proc {
 
@@ -58,6 +59,11 @@ class StatusReporter {
   // An error answering request_id (-1: none): status message and a log line.
   void error(std::int64_t request_id, const std::string& reason);
   void served() { ++served_; }
+  // A message on `channel` that does not decode (`what` says why): counted,
+  // a status error and a log line. Past 10 in a second, only counted until
+  // the next second, whose first report says how many went unreported.
+  void undecodable(const std::string& channel, const std::string& what);
+  std::int64_t undecodableCount() const { return undecodable_.load(); }
   void stopping();
   void tick();  // publishes if a second has passed since the last message
   std::int64_t errors() const { return errors_; }
@@ -69,19 +75,27 @@ class StatusReporter {
   process_status_t msg_;
   std::int64_t served_ = 0, errors_ = 0;
   std::int64_t last_publish_us_ = 0;
+  std::atomic<std::int64_t> undecodable_{0};
+  std::int64_t undecodable_window_us_ = 0, undecodable_in_window_ = 0, undecodable_unreported_ = 0;
 };
 
 std::int64_t nowMicros();  // wall clock, for utime
 
-// Decodes a raw LCM message; a message that does not decode is reported
-// (status error naming the channel, and a log line) and false returned, so a
-// corrupt message never kills a process and never passes silently.
+// Decodes a raw LCM message (the one decode path of every subscription): a
+// message that does not decode is counted and reported (status error naming
+// the channel and the reason, and a log line) and false returned, so a
+// malformed message never kills a process and never passes silently.
+template <class Msg>
+bool decode(const void* data, std::size_t size, const std::string& channel, Msg& out, StatusReporter& status) {
+  const std::string why = whyNotDecoded(data, size, out);
+  if (why.empty()) return true;
+  status.undecodable(channel, "a message of " + std::to_string(size) + " bytes does not decode as " +
+                                  Msg::getTypeName() + ": " + why);
+  return false;
+}
 template <class Msg>
 bool decode(const lcm::ReceiveBuffer* rb, const std::string& channel, Msg& out, StatusReporter& status) {
-  if (out.decode(rb->data, 0, static_cast<int>(rb->data_size)) >= 0) return true;
-  status.error(-1, channel + ": a message of " + std::to_string(rb->data_size) + " bytes does not decode as " +
-                       Msg::getTypeName());
-  return false;
+  return decode(rb->data, rb->data_size, channel, out, status);
 }
 
 // One request at a time, served on a worker thread while the LCM loop goes
@@ -97,18 +111,24 @@ class Worker {
   // Cancels the running job if it serves request_id (or any job for -1).
   bool cancel(std::int64_t request_id);
   void reap();  // joins a finished job; call from the loop
-  void stop();  // cancels and joins
+  // Cancels and joins, and the job is abandoned: a process that stops does
+  // not answer for work it did not finish (nobody cancelled that request).
+  void stop();
+  // True once stop() was called: a job checks it before it publishes its answer.
+  bool abandoned() const { return abandoned_.load(); }
 
  private:
   std::thread thread_;
-  std::atomic<bool> running_{false}, cancel_{false};
+  std::atomic<bool> running_{false}, cancel_{false}, abandoned_{false};
   std::atomic<std::int64_t> current_{-1};
 };
 
 // Serves LCM (handleTimeout) until a signal or until done() returns true,
-// calling on_tick() every period_ms. Returns 0, or 1 when LCM failed.
+// calling on_tick() every period_ms. Returns 0, or 1 when LCM failed. A
+// handler that throws costs its message, not the process: on_handler_error
+// gets what it threw (without one, the exception goes on to the caller).
 int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<bool()>& done = {},
-         int period_ms = 50);
+         int period_ms = 50, const std::function<void(const std::string&)>& on_handler_error = {});
 
 // Logs "process: message" to stderr with a timestamp (the process's log).
 void log(const std::string& process, const std::string& message);
@@ -127,6 +147,7 @@ class Service {
     worker_.stop();
     status_.stopping();
   }
+  void handlerFailed(const std::string& what) { status_.error(-1, "a message's handler failed: " + what); }
 
  protected:
   Bus& bus_;
@@ -142,11 +163,13 @@ int serve(const std::string& url, const std::string& process, const std::string&
     Bus bus(url);
     S service(bus, options);
     log(process, "serving " + serving + " on " + (url.empty() ? std::string("LCM's default URL") : url));
-    const int rc = spin(bus, [&] { service.tick(); });
+    const int rc = spin(
+        bus, [&] { service.tick(); }, {}, 50, [&](const std::string& what) { service.handlerFailed(what); });
     service.stop();
     log(process, "stopped");
     return rc;
   } catch (const std::exception& e) {
+    // The service (and its worker: abandoned, see Worker::stop) is gone by now.
     log(process, std::string("fatal: ") + e.what());
     return 1;
   }

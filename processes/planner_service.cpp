@@ -1,5 +1,6 @@
 #include "processes/planner_service.h"
 
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -95,6 +96,14 @@ class PlannerService : public proc::Service {
              "refused: busy with request " +
                  std::to_string(worker_.busy() ? worker_.current() : waiting_->req.request_id) +
                  " (one request at a time)");
+      return;
+    }
+    // "<= 0: the scenario's" must not swallow a NaN, nor inf buy an endless search.
+    if (!std::isfinite(req.time_budget_s) || req.time_budget_s > kMaxBudgetS) {
+      refuse(req, plan_t::INVALID_INPUT,
+             "time_budget_s " + std::to_string(req.time_budget_s) +
+                 ": expected a finite number of seconds, at most " + std::to_string(static_cast<long>(kMaxBudgetS)) +
+                 " (<= 0: the scenario's)");
       return;
     }
     auto sc = std::make_shared<Scenario>();
@@ -215,6 +224,7 @@ class PlannerService : public proc::Service {
       m.scenario_name = req.scenario_name;
       m.scenario_yaml = req.scenario_yaml;
       m.base_path = req.base_path;
+      if (worker_.abandoned()) return;  // stopping: no answer for unfinished work
       bus_.publish(channels::kPlan, m);
       status_.served();
       status_.idle();
@@ -244,6 +254,7 @@ class PlannerService : public proc::Service {
     std::int64_t since_us;
   };
   static constexpr std::int64_t kGuideTimeoutUs = 60'000'000;
+  static constexpr double kMaxBudgetS = 7 * 24 * 3600.0;  // a week
 
   PlannerOverrides overrides_;
   std::optional<Waiting> waiting_;            // a request waiting for its guide

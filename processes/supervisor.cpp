@@ -60,7 +60,7 @@ void Supervisor::start(const ChildSpec& spec) {
   children_.push_back(c);
 }
 
-std::vector<std::string> Supervisor::poll() {
+std::vector<std::string> Supervisor::poll(std::vector<std::string>* gone) {
   std::vector<std::string> restarted;
   for (auto& c : children_) {
     if (c.pid <= 0) continue;
@@ -76,7 +76,11 @@ std::vector<std::string> Supervisor::poll() {
       c.pid = spawn(c.spec);
       restarted.push_back(c.spec.name);
     } else {
-      log_(c.spec.name + " " + how + (c.spec.respawn ? ": not restarted (too many restarts)" : ""));
+      const std::string what =
+          c.spec.name + " " + how +
+          (c.spec.respawn ? ": not restarted (" + std::to_string(c.restarts) + " restarts already)" : "");
+      log_(what);
+      if (gone) gone->push_back(what);
     }
   }
   return restarted;

@@ -32,8 +32,10 @@ class Supervisor {
   // Starts a child; throws std::runtime_error if it cannot be started.
   void start(const ChildSpec& spec);
   // Reaps children that exited; restarts those allowed to. Returns the names
-  // restarted by this call.
-  std::vector<std::string> poll();
+  // restarted by this call; the children that exited and will not be
+  // restarted (too many restarts, or not to be respawned) are appended to
+  // `gone` with how they ended ("name killed by signal 6: not restarted ...").
+  std::vector<std::string> poll(std::vector<std::string>* gone = nullptr);
   void stopAll(double grace_s = 3.0);
 
   pid_t pid(const std::string& name) const;   // -1 if not running

@@ -88,3 +88,30 @@ TEST(AcyclicCheck, BadInputNamesTheFileAndExitsTwo) {
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.output.find("validity contract"), std::string::npos) << help.output;
 }
+
+TEST(AcyclicCheck, ScenarioInputErrorsAreBadInputNotViolations) {
+  acyclic::test::TempDir dir;
+  const std::string chair = acyclic::test::scenarioText("models/scenarios/chair_table.yaml");
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = chair;
+    EXPECT_NE(t.find(from), std::string::npos) << from;
+    t.replace(t.find(from), from.size(), to);
+    return dir.write("bad.yaml", t);
+  };
+  // A key given twice: both lines named.
+  const acyclic::test::ProcessRun twice = run(with("seed: 1\n", "seed: 1\nseed: 2\n"));
+  EXPECT_EQ(twice.status, 2) << twice.output;
+  EXPECT_NE(twice.output.find("bad.yaml"), std::string::npos) << twice.output;
+  EXPECT_NE(twice.output.find("given twice in one map (lines 10 and 11)"), std::string::npos) << twice.output;
+  // The planner section, read as the planner reads it.
+  const acyclic::test::ProcessRun planner =
+      run(with("  posture_iterations: 40\n", "  posture_iterations: 40\n  max_nodez: 3\n"));
+  EXPECT_EQ(planner.status, 2) << planner.output;
+  EXPECT_NE(planner.output.find("max_nodez"), std::string::npos) << planner.output;
+  // 1e300 degrees is not a joint beyond its limit: it is not an angle.
+  const acyclic::test::ProcessRun absurd = run(with("RLEG_JOINT3: 117.953", "RLEG_JOINT3: 1e300"));
+  EXPECT_EQ(absurd.status, 2) << absurd.output;
+  EXPECT_NE(absurd.output.find("RLEG_JOINT3"), std::string::npos) << absurd.output;
+  const acyclic::test::ProcessRun nan = run(with("RLEG_JOINT3: 117.953", "RLEG_JOINT3: .nan"));
+  EXPECT_EQ(nan.status, 2) << nan.output;
+}

@@ -791,3 +791,89 @@ TEST(Hrp2Sim, BridgeAndSimulatorEndToEndTrackingErrorIsSmall) {
   EXPECT_LT(st.tracking_error_max, 0.01);
   EXPECT_NEAR(sim.state().q[16], tr.samples.back().q.joints[16], 1e-3);
 }
+
+TEST(Hrp2Sim, CommandsBeyondPositionOrVelocityLimitsAreRefusedAndCountedAndNoJointPassesItsLimits) {
+  const Scenario& sc = chair();
+  SimulatedController sim(sc.robot, sc.start, SimOptions{});
+  const int chest = sc.robot->jointIndex("CHEST_JOINT0");
+  ASSERT_GE(chest, 0);
+  const double upper = sc.robot->upperLimits()[chest], vmax = sc.robot->velocityLimits()[chest];
+  SimCommand c;
+  c.q = sc.start.joints;
+  c.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
+  c.mode = 1;
+  std::int64_t now = 0;
+  // A foreign command driving the chest to 1.5 rad, past its limit.
+  SimCommand far = c;
+  far.q[chest] = 1.5;
+  ASSERT_GT(1.5, upper);
+  sim.receive(far, now);
+  for (int i = 0; i < 100; ++i) sim.step(now += 5000);
+  EXPECT_EQ(sim.refusedPosition(), 1);
+  EXPECT_EQ(sim.applied(), 0);
+  EXPECT_EQ(sim.state().q[chest], sc.start.joints[chest]);
+  // A velocity beyond the limit.
+  SimCommand fast = c;
+  fast.dq[chest] = 1.5 * vmax;
+  sim.receive(fast, now);
+  sim.step(now += 5000);
+  EXPECT_EQ(sim.refusedVelocity(), 1);
+  EXPECT_EQ(sim.applied(), 0);
+  // At the limit, with the largest velocity feed-forward allowed outwards: the
+  // first-order law alone would settle T * vmax past the limit; the joint stops.
+  SimCommand edge = c;
+  edge.q[chest] = upper;
+  edge.dq[chest] = vmax;
+  for (int i = 0; i < 200; ++i) {
+    edge.sequence = i;
+    sim.receive(edge, now);
+    sim.step(now += 5000);
+    ASSERT_LE(sim.state().q[chest], upper) << "period " << i;
+  }
+  EXPECT_NEAR(sim.state().q[chest], upper, 1e-9);
+  EXPECT_EQ(sim.refusedPosition(), 1);
+  EXPECT_EQ(sim.refusedVelocity(), 1);
+  EXPECT_EQ(sim.applied(), 200);
+}
+
+TEST(Hrp2Sim, HoldsTheLastCommandedPostureWhenTheCommandStreamStops) {
+  const Scenario& sc = chair();
+  auto run = [&](int hold_after) {
+    SimOptions o;
+    o.hold_after_missed = hold_after;
+    auto sim = std::make_unique<SimulatedController>(sc.robot, sc.start, o);
+    SimCommand c;
+    c.q = sc.start.joints;
+    c.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
+    c.mode = 1;
+    std::int64_t now = 0;
+    // A stream moving an arm joint at 0.5 rad/s, then silence (the bridge died).
+    for (int i = 0; i < 50; ++i) {
+      c.sequence = i;
+      c.q[16] = sc.start.joints[16] - 0.5 * 0.005 * i;
+      c.dq[16] = -0.5;
+      sim->receive(c, now);
+      sim->step(now += 5000);
+    }
+    for (int i = 0; i < 19; ++i) sim->step(now += 5000);
+    EXPECT_FALSE(sim->holdingForMissedCommands()) << "not before " << hold_after << " periods";
+    for (int i = 0; i < 200; ++i) sim->step(now += 5000);
+    return std::make_pair(std::move(sim), c.q[16]);
+  };
+  auto [held, last_ref] = run(20);
+  EXPECT_TRUE(held->holdingForMissedCommands());
+  EXPECT_EQ(held->missedHolds(), 1);
+  EXPECT_NEAR(held->state().q[16], last_ref, 1e-6) << "holds the last commanded posture";
+  EXPECT_LT(held->state().dq.cwiseAbs().maxCoeff(), 1e-6);
+  // Without the hold the stale feed-forward keeps the joint T * 0.5 rad/s past it.
+  auto [free_running, ref] = run(0);
+  EXPECT_EQ(free_running->missedHolds(), 0);
+  EXPECT_GT(std::abs(free_running->state().q[16] - ref), 5e-3);
+  // A new command ends the hold.
+  SimCommand c;
+  c.q = held->state().q;
+  c.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
+  held->receive(c, 2'000'000);
+  held->step(2'005'000);
+  EXPECT_FALSE(held->holdingForMissedCommands());
+}

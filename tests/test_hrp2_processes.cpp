@@ -30,6 +30,7 @@
 #include "acyclic/trajectory_t.hpp"
 #include "channels.hpp"
 #include "processes/lcm_convert.h"
+#include "fuzz_support.h"
 #include "test_support.h"
 
 extern char** environ;
@@ -480,4 +481,138 @@ TEST_F(Hrp2Processes, HelpAndBadInput) {
   const auto x = test::runProcess(test::binaryPath("processes/acyclic-hrp2-export") + " --in " + bad + " --out " +
                                   dir_.path() + "/x");
   EXPECT_EQ(x.status, 2) << x.output;
+}
+
+namespace {
+
+template <class Msg>
+void publishMalformed(lcm::LCM& lcm, const char* channel, const Msg& good, std::uint64_t seed) {
+  int k = 0;
+  for (const auto& b : test::malformed(test::encoded(good), seed)) {
+    lcm.publish(channel, b.data(), static_cast<unsigned>(b.size()));
+    if (++k % 25 == 0) lcm.handleTimeout(5);
+  }
+}
+
+bool processError(const Heard& h, const std::string& process, const std::string& needle) {
+  for (const auto& p : h.process)
+    if (p.process == process && p.state == process_status_t::ERROR && p.reason.find(needle) != std::string::npos)
+      return true;
+  return false;
+}
+
+}  // namespace
+
+TEST_F(Hrp2Processes, FuzzOnEveryChannelLeavesBridgeAndSimulatorUpAndAGoodTrajectoryStillPlays) {
+  Child& s = sim();
+  Child& b = spawn("acyclic-hrp2-bridge", {"--scenario", chair().path, "--config", tolerantConfig()});
+  ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::IDLE); }, 10)) << logs();
+  const long bridge_peak = test::residentKib(b.pid), sim_peak = test::residentKib(s.pid);
+
+  hrp2_state_t st{};
+  st.num_joints = 2;
+  st.q = {0.1, 0.2};
+  st.dq = {0, 0};
+  st.base_orientation[0] = 1;
+  st.num_wrenches = 1;
+  st.wrench_names = {"rfsensor"};
+  st.wrenches = {std::vector<double>(6, 1.0)};
+  publishMalformed(*lcm_, channels::kHrp2State, st, 21);
+  hrp2_estop_t es{};
+  es.source = "fuzz";
+  es.reason = "fuzz";
+  publishMalformed(*lcm_, channels::kHrp2Estop, es, 22);
+  trajectory_t tr{};
+  tr.request_id = 900;
+  tr.status = trajectory_t::ERROR;  // decodable variants: nothing to do (or refused)
+  tr.reason = "fuzz";
+  tr.num_joints = 1;
+  tr.joint_names = {"J"};
+  publishMalformed(*lcm_, channels::kTrajectory, tr, 23);
+  hrp2_command_t cmd{};
+  cmd.request_id = 900;
+  cmd.num_joints = 2;
+  cmd.q = {0.1, 0.2};
+  cmd.dq = {0, 0};
+  publishMalformed(*lcm_, channels::kHrp2Command, cmd, 24);
+  // Past the reports' rate limit (10 a second), one more on each channel: its
+  // report is not lost in the flood this test's own socket may drop.
+  serveFor(1.2);
+  heard_.process.clear();
+  heard_.states.clear();
+  const char garbage[] = "not an LCM message";
+  for (const char* channel :
+       {channels::kHrp2State, channels::kHrp2Estop, channels::kTrajectory, channels::kHrp2Command})
+    lcm_->publish(channel, garbage, sizeof garbage);
+  // A well-formed foreign command driving the chest past its limit.
+  const int chest = chair().robot->jointIndex("CHEST_JOINT0");
+  const double chest_max = chair().robot->upperLimits()[chest];
+  hrp2_command_t foreign{};
+  foreign.request_id = 901;
+  foreign.mode = hrp2_command_t::HOLD;
+  foreign.num_joints = chair().robot->numJoints();
+  foreign.q.assign(chair().start.joints.data(), chair().start.joints.data() + foreign.num_joints);
+  foreign.dq.assign(foreign.num_joints, 0.0);
+  foreign.q[chest] = 1.5;
+  for (int i = 0; i < 20; ++i) lcm_->publish(channels::kHrp2Command, &foreign);
+  serveFor(1.0);
+
+  int st_bridge = 0, st_sim = 0;
+  ASSERT_EQ(waitpid(b.pid, &st_bridge, WNOHANG), 0) << "the bridge died\n" << logs();
+  ASSERT_EQ(waitpid(s.pid, &st_sim, WNOHANG), 0) << "the simulator died\n" << logs();
+  EXPECT_TRUE(processError(heard_, "acyclic-hrp2-bridge", "HRP2_STATE: a message of")) << logs();
+  EXPECT_TRUE(processError(heard_, "acyclic-hrp2-bridge", "ACYCLIC_TRAJECTORY: a message of")) << logs();
+  EXPECT_TRUE(processError(heard_, "acyclic-hrp2-bridge", "HRP2_ESTOP")) << logs();
+  EXPECT_TRUE(processError(heard_, "acyclic-hrp2-sim", "HRP2_COMMAND: a message of")) << logs();
+  EXPECT_TRUE(processError(heard_, "acyclic-hrp2-sim", "beyond the joint limits")) << logs();
+  ASSERT_FALSE(heard_.states.empty());
+  for (const auto& m : heard_.states) {
+    ASSERT_EQ(m.num_joints, chair().robot->numJoints());
+    ASSERT_LE(m.q[chest], chest_max + 1e-9) << "the foreign command moved the chest";
+  }
+  const long bridge_grown = test::residentKib(b.pid) - bridge_peak, sim_grown = test::residentKib(s.pid) - sim_peak;
+  EXPECT_LT(bridge_grown, 64 * 1024) << "KiB";
+  EXPECT_LT(sim_grown, 64 * 1024) << "KiB";
+  std::printf("peak memory under fuzz: bridge %+ld KiB, simulator %+ld KiB\n", bridge_grown, sim_grown);
+
+  // The undecodable e-stops engaged it: reset (engage, release), then a good
+  // trajectory plays to the end.
+  hrp2_estop_t reset{};
+  reset.engage = true;
+  reset.source = "test";
+  lcm_->publish(channels::kHrp2Estop, &reset);
+  serveFor(0.2);
+  reset.engage = false;
+  lcm_->publish(channels::kHrp2Estop, &reset);
+  ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::IDLE); }, 10)) << logs();
+  heard_ = Heard{};
+  publish(message(armMotion(1.0, -0.3), 5));
+  ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::STREAMING); }, 10)) << logs();
+  ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::IDLE); }, 10)) << logs();
+  EXPECT_EQ(heard_.statuses.back().reason.rfind("done: request 5 ", 0), 0u) << heard_.statuses.back().reason;
+  EXPECT_EQ(stop(b), 0) << logs();
+  EXPECT_EQ(stop(s), 0);
+}
+
+TEST_F(Hrp2Processes, ABridgeKilledMidMotionLeavesTheSimulatorHoldingTheLastCommandedPosture) {
+  const std::string file = trajectoryFile(armMotion(2.0, -0.4), "arm.json");
+  Child& s = sim();
+  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig(false)});
+  ASSERT_TRUE(serveUntil([&] { return heard_.commands.size() > 140; }, 10)) << logs();  // 0.7 s into the motion
+  kill(b.pid, SIGKILL);
+  waitpid(b.pid, nullptr, 0);
+  b.pid = -1;
+  serveFor(0.6);
+  const hrp2_command_t last = heard_.commands.back();
+  ASSERT_EQ(last.mode, +hrp2_command_t::STREAM);
+  ASSERT_GT(std::abs(last.dq[16]), 0.1) << "killed while the arm moves";
+  EXPECT_NE(test::readFile(s.log).find("holding the last commanded posture"), std::string::npos) << logs();
+  // At rest on the last commanded posture, not T * dq past it (the stale
+  // feed-forward of the last command).
+  const hrp2_state_t& now = heard_.states.back();
+  EXPECT_NEAR(now.q[16], last.q[16], 1e-3) << "feed-forward offset would be " << 0.02 * last.dq[16];
+  double dq_max = 0;
+  for (double v : now.dq) dq_max = std::max(dq_max, std::abs(v));
+  EXPECT_LT(dq_max, 1e-3);
+  EXPECT_EQ(stop(s), 0) << logs();
 }

@@ -7,7 +7,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -15,6 +17,8 @@
 #include <thread>
 
 #include "acyclic/cancel_t.hpp"
+#include "acyclic/guide_t.hpp"
+#include "acyclic/progress_t.hpp"
 #include "acyclic/hrp2_bridge_status_t.hpp"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/process_status_t.hpp"
@@ -23,6 +27,7 @@
 #include "lcmtypes/channels.hpp"
 #include "processes/lcm_process.h"
 #include "processes/supervisor.h"
+#include "fuzz_support.h"
 #include "test_support.h"
 
 using namespace acyclic;
@@ -353,4 +358,234 @@ TEST(Pipeline, AScenarioWithoutKeyPosturesIsGuidedByTheOmplAuthor) {
   int guides = 0;
   for (const lcm::LogEvent* e; (e = log.readNextEvent());) guides += e->channel == channels::kGuide;
   EXPECT_EQ(guides, 1);
+}
+
+namespace {
+
+// Publishes every malformed variant of `good` on `channel`, draining the
+// client's own queue now and then (it hears the processes' errors).
+template <class Msg>
+void publishMalformed(Client& c, const char* channel, const Msg& good, std::uint64_t seed) {
+  int k = 0;
+  for (const auto& b : test::malformed(test::encoded(good), seed)) {
+    c.bus.publishRaw(channel, b.data(), static_cast<unsigned>(b.size()));
+    if (++k % 25 == 0) c.bus.lcm().handleTimeout(5);
+  }
+}
+
+// Malformed variants of every message the services subscribe to. The good
+// messages are refused when they do decode (a scenario that does not load),
+// so that no fuzzed variant starts real work.
+void fuzzServiceChannels(Client& c) {
+  request_t req{};
+  req.request_id = 100;
+  req.scenario_name = "fuzz";
+  req.scenario_yaml = "format: fuzz\n";
+  req.base_path = "/";
+  req.seed = -1;
+  req.time_budget_s = -1;
+  publishMalformed(c, channels::kRequest, req, 1);
+  cancel_t cancel{};
+  cancel.request_id = 12345;
+  cancel.reason = "fuzz";
+  publishMalformed(c, channels::kCancel, cancel, 2);
+  guide_t g{};
+  g.request_id = 100;
+  g.source = "fuzz";
+  configuration_t q{};
+  q.base_orientation[0] = 1;
+  q.num_joints = 2;
+  q.joints = {0.1, 0.2};
+  g.num_postures = 1;
+  g.postures = {q};
+  publishMalformed(c, channels::kGuide, g, 3);
+  plan_t plan{};
+  plan.request_id = 101;
+  plan.scenario_yaml = "format: fuzz\n";
+  plan.num_joints = 1;
+  plan.joint_names = {"J"};
+  stance_t s{};
+  s.configuration = q;
+  plan.num_stances = 1;
+  plan.stances = {s};
+  publishMalformed(c, channels::kPlan, plan, 4);
+}
+
+}  // namespace
+
+TEST(Pipeline, FuzzOnEveryChannelLeavesEveryServiceUpAnsweringWithBoundedMemory) {
+  REQUIRE_NETNS();
+  Client c;
+  Processes p;
+  std::vector<std::string> names = {"acyclic-guide", "acyclic-planner"};
+  if (haveInterpolator()) names.push_back("acyclic-interpolator");
+  for (const auto& n : names) p.start(n);
+  for (const auto& n : names)
+    ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(n, process_status_t::IDLE); }, 20)) << n;
+  std::map<std::string, long> peak_before;
+  for (const auto& n : names) peak_before[n] = test::residentKib(p.sup.pid(n));
+
+  fuzzServiceChannels(c);
+  // Past the reports' rate limit (10 a second), one more on each channel: its
+  // report is not lost in the flood the client's own socket may drop.
+  c.waitFor([] { return false; }, 1.2);
+  c.statuses.clear();
+  const char garbage[] = "not an LCM message";
+  for (const char* channel : {channels::kRequest, channels::kCancel, channels::kGuide, channels::kPlan})
+    c.bus.publishRaw(channel, garbage, sizeof garbage);
+  for (const auto& n : names)
+    EXPECT_TRUE(c.waitFor([&] { return c.error(n, "does not decode") != nullptr; }, 10)) << n;
+  c.waitFor([] { return false; }, 1.0);  // the last ones handled
+  for (const auto& n : names) {
+    ASSERT_TRUE(p.sup.running(n)) << n << " died";
+    const process_status_t* e = c.error(n, "does not decode");
+    ASSERT_NE(e, nullptr) << n;
+    EXPECT_NE(e->reason.find("ACYCLIC_"), std::string::npos) << "names the channel: " << e->reason;
+    EXPECT_NE(e->reason.find("refused so far"), std::string::npos) << e->reason;
+    const long grown = test::residentKib(p.sup.pid(n)) - peak_before[n];
+    EXPECT_LT(grown, 64 * 1024) << n << ": peak memory grew by " << grown << " KiB under fuzz";
+    std::printf("%s: peak memory %+ld KiB under fuzz\n", n.c_str(), grown);
+  }
+  // Still answering: a scenario without key postures needs the guide, then the
+  // planner (and the interpolator after it).
+  test::TempDir dir;
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  text = text.substr(0, text.find("key_postures:"));
+  request_t good = c.request(8, "models/scenarios/step_forward.yaml");
+  good.scenario_yaml = text;
+  c.bus.publish(channels::kRequest, good);
+  ASSERT_TRUE(c.waitFor([&] { return c.plans.count(8) > 0; }, 90));
+  EXPECT_EQ(c.plans[8].status, +plan_t::OK) << c.plans[8].reason;
+  if (haveInterpolator()) {
+    ASSERT_TRUE(c.waitFor([&] { return c.trajectories.count(8) > 0; }, 60));
+    EXPECT_EQ(c.trajectories[8].status, +trajectory_t::OK) << c.trajectories[8].reason;
+  }
+  for (const auto& n : names) EXPECT_TRUE(p.sup.running(n)) << n;
+}
+
+TEST(Pipeline, BadRequestFieldsAndAPoisonedCancelKillNothingAndAStoppedPlannerAnswersNoUnfinishedWork) {
+  REQUIRE_NETNS();
+  Client c;
+  const pid_t pid = spawn({exe("acyclic-planner"), "--lcm"});
+  ASSERT_TRUE(c.waitFor([&] { return c.sawStatus("acyclic-planner", process_status_t::IDLE); }, 20));
+  // A time budget of NaN or inf is refused with the reason.
+  c.bus.publish(channels::kRequest, c.request(2, "models/scenarios/step_forward.yaml", std::nan("")));
+  c.bus.publish(channels::kRequest, c.request(3, "models/scenarios/step_forward.yaml", HUGE_VAL));
+  ASSERT_TRUE(c.waitFor([&] { return c.plans.count(2) > 0 && c.plans.count(3) > 0; }, 10));
+  for (const int id : {2, 3}) {
+    EXPECT_EQ(c.plans[id].status, +plan_t::INVALID_INPUT) << c.plans[id].reason;
+    EXPECT_NE(c.plans[id].reason.find("time_budget_s"), std::string::npos) << c.plans[id].reason;
+  }
+  c.bus.publish(channels::kRequest, c.request(1, "models/scenarios/chair_table.yaml", 60));
+  ASSERT_TRUE(c.waitFor([&] { return c.sawStatus("acyclic-planner", process_status_t::BUSY, 1); }, 20));
+  // A cancel whose reason has a length of -1.
+  cancel_t cancel{};
+  cancel.request_id = 1;
+  cancel.reason = "x";
+  test::Bytes b = test::encoded(cancel);
+  std::fill(b.begin() + 24, b.begin() + 28, 0xFF);
+  c.bus.publishRaw(channels::kCancel, b.data(), static_cast<unsigned>(b.size()));
+  ASSERT_TRUE(c.waitFor([&] { return c.error("acyclic-planner", "does not decode") != nullptr; }, 10));
+  c.waitFor([] { return false; }, 1.0);
+  EXPECT_EQ(c.plans.count(1), 0u) << "a cancel that does not decode cancelled the request";
+  int st = 0;
+  EXPECT_EQ(waitpid(pid, &st, WNOHANG), 0) << "the planner died";
+  // Stopped mid-request: no plan for the request it did not finish (nobody cancelled it).
+  kill(pid, SIGTERM);
+  EXPECT_EQ(waitExit(pid, 10), 0);
+  c.waitFor([] { return false; }, 1.0);
+  EXPECT_TRUE(c.sawStatus("acyclic-planner", process_status_t::STOPPING));
+  EXPECT_EQ(c.plans.count(1), 0u) << "status " << int(c.plans[1].status) << ": " << c.plans[1].reason;
+}
+
+TEST(Pipeline, AStageThatCannotBeRestartedFailsTheRunAtOnce) {
+  REQUIRE_NETNS();
+  test::TempDir dir;
+  // Stages that die at once, every time.
+  for (const char* name : {"acyclic-guide", "acyclic-planner"}) {
+    const std::string path = dir.write(name, "#!/bin/sh\necho 'dying'\nexit 3\n");
+    fs::permissions(path, fs::perms::owner_all);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto run = test::runProcess(exe("acyclic-launch") + " -q --no-interpolate --scenario " +
+                                    test::sourcePath("models/scenarios/step_forward.yaml") + " --bin-dir " +
+                                    dir.path() + " --out " + dir.path() + "/run");
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("failed: acyclic-"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("not restarted (3 restarts already)"), std::string::npos) << run.output;
+  EXPECT_LT(s, 15.0) << "waited instead of failing: " << run.output;
+  std::printf("failed after %.2f s\n", s);
+}
+
+TEST(Pipeline, TheLauncherSurvivesFuzzOnEveryChannelItHears) {
+  REQUIRE_NETNS();
+  test::TempDir dir;
+  std::atomic<bool> finished{false};
+  test::ProcessRun run;
+  Client c;
+  process_status_t st{};
+  st.process = "fuzz-process";
+  st.reason = "fuzz";
+  plan_t plan{};
+  plan.request_id = 999;
+  plan.reason = "fuzz";
+  progress_t pr{};
+  pr.request_id = 999;
+  pr.source = "fuzz";
+  hrp2_bridge_status_t bs{};
+  bs.request_id = 999;
+  bs.reason = "fuzz";
+  std::uint64_t seed = 10;
+  // Malformed messages on every channel the launcher hears, for the whole run
+  // (which takes about a second).
+  std::thread launcher([&] {
+    run = test::runProcess(exe("acyclic-launch") + " -q --no-interpolate --scenario " +
+                           test::sourcePath("models/scenarios/step_forward.yaml") + " --out " + dir.path());
+    finished = true;
+  });
+  while (!finished) {
+    publishMalformed(c, channels::kStatus, st, seed++);
+    publishMalformed(c, channels::kPlan, plan, seed++);
+    publishMalformed(c, channels::kProgress, pr, seed++);
+    publishMalformed(c, channels::kHrp2BridgeStatus, bs, seed++);
+    c.waitFor([] { return false; }, 0.05);
+  }
+  launcher.join();
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(fs::exists(dir.path() + "/plan.json")) << run.output;
+  EXPECT_NE(run.output.find("does not decode"), std::string::npos) << run.output;
+}
+
+TEST(Pipeline, ReplayOfALogWithUndecodableMessagesSaysSoAndDoesNotCrash) {
+  REQUIRE_NETNS();
+  test::TempDir dir;
+  const std::string path = dir.path() + "/poisoned.lcmlog";
+  {
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+    request_t req{};
+    req.scenario_name = "x";
+    test::Bytes b = test::encoded(req);
+    std::fill(b.begin() + 24, b.begin() + 28, 0xFF);  // scenario_name's length: -1
+    lcm::LogEvent e{};
+    e.eventnum = 0;
+    e.timestamp = 1;
+    e.channel = channels::kRequest;
+    e.datalen = static_cast<int32_t>(b.size());
+    e.data = b.data();
+    log.writeEvent(&e);
+    trajectory_t tr{};
+    test::Bytes t = test::encoded(tr);
+    std::fill(t.begin() + 8 + 17 + 4 + 1 + 8, t.begin() + 8 + 17 + 4 + 1 + 12, 0xFF);  // num_joints: -1
+    e.eventnum = 1;
+    e.channel = channels::kTrajectory;
+    e.datalen = static_cast<int32_t>(t.size());
+    e.data = t.data();
+    log.writeEvent(&e);
+  }
+  const auto run = test::runProcess(exe("acyclic-replay") + " " + path);
+  EXPECT_EQ(run.status, 2) << run.output;  // nothing left to replay: bad input, not a crash
+  EXPECT_NE(run.output.find("event 0 on ACYCLIC_REQUEST does not decode"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("event 1 on ACYCLIC_TRAJECTORY does not decode"), std::string::npos) << run.output;
 }

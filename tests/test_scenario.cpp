@@ -2,6 +2,8 @@
 // bad files rejected with an error naming the file, the field and the expectation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "planner/common/format_error.h"
 #include "planner/model/kinematics.h"
 #include "planner/scene/scenario.h"
@@ -208,4 +210,31 @@ TEST(RobotFiles, BadFieldsNameTheRobotFile) {
   EXPECT_EQ(load("{a: [RLEG_LINK5], b: [RLEG_LINK2]}", "{a: [RLEG_LINK5], b: [RLEG_LINK1]}"),
             "self_collision_pairs[7].b[0]");  // a link without collision shapes
   EXPECT_EQ(load("  LARM_JOINT0, LARM_JOINT1,", "  LARM_JOINT1,"), "controller_order[23]");
+}
+
+TEST(ScenarioFiles, AKeyGivenTwiceIsRefusedWithBothLines) {
+  // The second seed is the file's last line.
+  const std::string text = scenarioText() + "seed: 1\nseed: 2\n";
+  const int last = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  expectFormatError(text, "seed", "given twice in one map (lines " + std::to_string(last - 1) + " and " +
+                                      std::to_string(last) + ")");
+  std::string nested = scenarioText();
+  nested.replace(nested.find("{posture: sitting}"), 18,
+                 "{posture: sitting, joints_deg: {RLEG_JOINT3: 3, RLEG_JOINT3: 4}}");
+  expectFormatError(nested, "start.configuration.joints_deg.RLEG_JOINT3", "given twice");
+}
+
+TEST(ScenarioFiles, NonFiniteOrAbsurdNumbersAreBadInput) {
+  std::string deg = scenarioText();
+  deg.replace(deg.find("{posture: sitting}"), 18, "{posture: sitting, joints_deg: {RLEG_JOINT3: 1e300}}");
+  expectFormatError(deg, "start.configuration.joints_deg.RLEG_JOINT3", "plausible magnitude");
+  std::string turns = scenarioText();
+  turns.replace(turns.find("{posture: sitting}"), 18, "{posture: sitting, joints_deg: {RLEG_JOINT3: 1000}}");
+  expectFormatError(turns, "start.configuration.joints_deg.RLEG_JOINT3", "within +-720");
+  std::string nan = scenarioText();
+  nan.replace(nan.find("{posture: sitting}"), 18, "{posture: sitting, base_position: [0, .nan, 0]}");
+  expectFormatError(nan, "start.configuration.base_position[1]", "finite");
+  expectFormatError(scenarioText("", "{link: WAIST, axis: y, min: 1e300}"), "goal.min", "plausible magnitude");
+  expectFormatError(scenarioText("    - {spot: l_sole, surface: floor, theta_deg: 1000}\n"),
+                    "start.contacts[1].theta_deg", "within +-720");
 }

@@ -14,6 +14,7 @@ void SimOptions::validate() const {
   if (!(time_constant > 0)) bad("time_constant: expected a positive time (s)");
   if (!(latency >= 0)) bad("latency: expected a non-negative time (s)");
   if (!(drop_rate >= 0 && drop_rate < 1)) bad("drop_rate: expected a fraction in [0, 1)");
+  if (hold_after_missed < 0) bad("hold_after_missed: expected a number of periods >= 0 (0: never)");
 }
 
 SimulatedController::SimulatedController(std::shared_ptr<const RobotModel> robot, const Configuration& start,
@@ -23,6 +24,8 @@ SimulatedController::SimulatedController(std::shared_ptr<const RobotModel> robot
   if (start.joints.size() != robot->numJoints()) throw std::invalid_argument("simulator: start has the wrong joint count");
   dq_ = Eigen::VectorXd::Zero(robot->numJoints());
   vmax_ = robot->velocityLimits();
+  qmin_ = robot->lowerLimits();
+  qmax_ = robot->upperLimits();
 }
 
 bool SimulatedController::frozen(std::int64_t now) const {
@@ -43,12 +46,25 @@ void SimulatedController::receive(const SimCommand& c, std::int64_t now) {
     ++rejected_;
     return;
   }
+  // A real controller refuses a reference beyond the joint's limits rather
+  // than drive into its stops (a rounding's worth of tolerance).
+  constexpr double kTolerance = 1e-9;
+  if ((c.q.array() < qmin_.array() - kTolerance).any() || (c.q.array() > qmax_.array() + kTolerance).any()) {
+    ++refused_position_;
+    return;
+  }
+  if ((c.dq.array().abs() > vmax_.array() + kTolerance).any()) {
+    ++refused_velocity_;
+    return;
+  }
+  last_command_at_ = now;
   pending_.emplace_back(now + std::llround(opt_.latency * 1e6), c);
 }
 
 void SimulatedController::apply(const SimCommand& c) {
   current_ = c;
   has_command_ = true;
+  holding_missed_ = false;
   ++applied_;
 }
 
@@ -62,6 +78,13 @@ void SimulatedController::integrate(double h) {
   // with h <= dt < T is stable.
   Eigen::VectorXd v = current_.dq + (current_.q - q_.joints) / T;
   v = v.cwiseMax(-vmax_).cwiseMin(vmax_);
+  // The joint stops: a joint never moves past its limits (one that starts
+  // outside them may only move back).
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    const double next = q_.joints[i] + h * v[i];
+    const double lo = std::min(qmin_[i], q_.joints[i]), hi = std::max(qmax_[i], q_.joints[i]);
+    if (next < lo || next > hi) v[i] = (std::clamp(next, lo, hi) - q_.joints[i]) / h;
+  }
   q_.joints += h * v;
   dq_ = v;
   if (current_.mode == 0) {
@@ -85,6 +108,16 @@ void SimulatedController::step(std::int64_t now) {
   while (!pending_.empty() && pending_.front().first <= now) {
     apply(pending_.front().second);
     pending_.pop_front();
+  }
+  // The command stream stopped (its sender died or hangs): hold the last
+  // commanded posture without its velocity feed-forward, the base where it
+  // stands, rather than go on with a reference nobody updates.
+  if (opt_.hold_after_missed > 0 && has_command_ && !holding_missed_ && pending_.empty() &&
+      now - last_command_at_ > std::llround(opt_.hold_after_missed * opt_.dt * 1e6)) {
+    holding_missed_ = true;
+    ++missed_holds_;
+    current_.mode = 1;
+    current_.dq.setZero();
   }
   double elapsed = (now - last_step_) * 1e-6;
   last_step_ = now;

@@ -7,6 +7,17 @@
 // takes milliseconds, so the caller computes them off the control loop and
 // attaches them to the state. Fault options: latency, dropped commands, a
 // freeze (the controller hangs: no motion, no state).
+//
+// Like a real controller it keeps the model's limits whatever it is sent: a
+// command with a position outside the joint limits or a velocity beyond the
+// velocity limits is refused (counted; the previous reference stays), and the
+// joints never leave their position limits. It has no joint torques (the
+// joints are kinematic), so it enforces no torque limit: a dynamic simulation
+// compares its torques with RobotModel::effortLimits(). And like the
+// controller a lab should run, it holds by itself when the command stream
+// stops: after hold_after_missed periods without a command it holds the last
+// commanded posture, with no velocity feed-forward and the base where it
+// stands (the bridge that sent the stream may have died).
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -29,6 +40,10 @@ struct SimOptions {
   std::uint64_t seed = 1;
   double freeze_after = -1;        // s after the first command the controller hangs; < 0: never
   bool servo_on = true;
+  // Periods without a command, once commands have come, after which the
+  // controller holds the last commanded posture (velocity reference zero,
+  // the base where it stands); 0: never.
+  int hold_after_missed = 20;
   void validate() const;           // std::invalid_argument naming the bad value
 };
 
@@ -68,6 +83,14 @@ class SimulatedController {
   long dropped() const { return dropped_; }
   long rejected() const { return rejected_; }
   long applied() const { return applied_; }
+  // Commands refused for a position outside the joint limits, or a velocity
+  // beyond the velocity limits (a command with both counts as a position).
+  long refusedPosition() const { return refused_position_; }
+  long refusedVelocity() const { return refused_velocity_; }
+  // Times the command stream stopped for hold_after_missed periods (each
+  // started a hold), and whether the controller holds for that reason now.
+  long missedHolds() const { return missed_holds_; }
+  bool holdingForMissedCommands() const { return holding_missed_; }
 
  private:
   void apply(const SimCommand& c);
@@ -77,13 +100,15 @@ class SimulatedController {
   SimOptions opt_;
   Configuration q_;
   Eigen::VectorXd dq_;
-  Eigen::VectorXd vmax_;
+  Eigen::VectorXd vmax_, qmin_, qmax_;
   std::deque<std::pair<std::int64_t, SimCommand>> pending_;  // due time, command
   SimCommand current_;
   bool has_command_ = false;
-  std::int64_t first_command_at_ = -1, last_step_ = -1;
+  std::int64_t first_command_at_ = -1, last_step_ = -1, last_command_at_ = -1;
+  bool holding_missed_ = false;
   std::mt19937_64 rng_;
   long received_ = 0, dropped_ = 0, rejected_ = 0, applied_ = 0;
+  long refused_position_ = 0, refused_velocity_ = 0, missed_holds_ = 0;
 };
 
 }  // namespace acyclic::hrp2

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "planner/common/geometry.h"
@@ -16,9 +17,35 @@ YamlField YamlField::loadFile(const std::string& path) {
   return loadText(ss.str(), path);
 }
 
+namespace {
+
+// yaml-cpp keeps both entries of a key given twice and lookups see one of
+// them: the other value would be silently ignored.
+void refuseDuplicateKeys(const YAML::Node& n, const std::string& origin, const std::string& path) {
+  if (n.IsMap()) {
+    std::map<std::string, int> lines;
+    for (const auto& kv : n) {
+      if (!kv.first.IsScalar()) continue;
+      const std::string key = kv.first.Scalar();
+      const int line = kv.first.Mark().line + 1;
+      const auto [it, fresh] = lines.emplace(key, line);
+      if (!fresh)
+        throw FormatError(origin, path.empty() ? key : path + "." + key,
+                          "given twice in one map (lines " + std::to_string(it->second) + " and " +
+                              std::to_string(line) + ")");
+      refuseDuplicateKeys(kv.second, origin, path.empty() ? key : path + "." + key);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) refuseDuplicateKeys(n[i], origin, path + "[" + std::to_string(i) + "]");
+  }
+}
+
+}  // namespace
+
 YamlField YamlField::loadText(const std::string& text, const std::string& origin) {
   try {
     YAML::Node n = YAML::Load(text);
+    refuseDuplicateKeys(n, origin, "");
     if (!n.IsMap()) throw FormatError(origin, "", "expected a YAML map at the top level");
     return YamlField(n, origin, "");
   } catch (const YAML::Exception& e) {
@@ -73,7 +100,27 @@ double YamlField::number() const {
   if (!node_.IsScalar()) fail("a number");
   double v;
   if (!YAML::convert<double>::decode(node_, v) || !std::isfinite(v)) fail("a finite number");
+  if (std::abs(v) > 1e9) fail("a number of plausible magnitude (at most 1e9)");
   return v;
+}
+
+double YamlField::angle() const {
+  const double v = number();
+  if (std::abs(v) > 4 * M_PI) fail("an angle in radians within +-4 pi");
+  return v;
+}
+
+double YamlField::degrees() const {
+  const double v = number();
+  if (std::abs(v) > 720) fail("an angle in degrees within +-720");
+  return v;
+}
+
+Eigen::Vector3d YamlField::angles3(bool degrees) const {
+  if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 angles");
+  Eigen::Vector3d a;
+  for (int i = 0; i < 3; ++i) a[i] = degrees ? at(i).degrees() : at(i).angle();
+  return a;
 }
 
 int YamlField::integer() const {
@@ -156,8 +203,8 @@ Eigen::Quaterniond readOrientation(const YamlField& parent) {
   if (count > 1)
     throw FormatError(parent.file(), parent.path(),
                       "give at most one of rpy, rpy_deg, quaternion");
-  if (parent.has("rpy")) return rpyToQuaternion(parent["rpy"].vec3());
-  if (parent.has("rpy_deg")) return rpyToQuaternion(parent["rpy_deg"].vec3() * M_PI / 180.0);
+  if (parent.has("rpy")) return rpyToQuaternion(parent["rpy"].angles3(false));
+  if (parent.has("rpy_deg")) return rpyToQuaternion(parent["rpy_deg"].angles3(true) * M_PI / 180.0);
   if (parent.has("quaternion")) {
     auto v = parent["quaternion"].numbers(4);
     Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);

@@ -14,7 +14,8 @@ namespace acyclic {
 
 class YamlField {
  public:
-  // Loads a file; a missing file or a YAML syntax error is a FormatError.
+  // Loads a file; a missing file, a YAML syntax error or a key given twice in
+  // one map (both lines named) is a FormatError.
   static YamlField loadFile(const std::string& path);
   // Parses text that came from `origin` (a file name or a message description).
   static YamlField loadText(const std::string& text, const std::string& origin);
@@ -36,7 +37,15 @@ class YamlField {
   bool isSequence() const { return node_.IsSequence(); }
   bool isScalar() const { return node_.IsScalar(); }
 
+  // A finite number of plausible magnitude (|x| <= 1e9): a non-finite or
+  // absurd value is bad input, named with its file and field.
   double number() const;
+  // An angle in radians (|a| <= 4 pi), or in degrees (|a| <= 720, returned
+  // in degrees: the caller converts as it always did, bit for bit): any
+  // orientation or joint angle is within that.
+  double angle() const;
+  double degrees() const;
+  Eigen::Vector3d angles3(bool degrees) const;  // [a, b, c], in the unit asked for
   int integer() const;
   bool boolean() const;
   std::string string() const;

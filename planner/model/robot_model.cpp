@@ -352,10 +352,11 @@ Configuration RobotModel::readConfiguration(const YamlField& f) const {
     if (std::abs(o.norm() - 1) > 1e-6) f["base_orientation"].fail("a unit quaternion [w, x, y, z]");
     q.base_orientation = o.normalized();
   }
-  if (f.has("base_rpy_deg")) q.base_orientation = rpyToQuaternion(f["base_rpy_deg"].vec3() * M_PI / 180);
+  if (f.has("base_rpy_deg")) q.base_orientation = rpyToQuaternion(f["base_rpy_deg"].angles3(true) * M_PI / 180);
   if (f.has("joints")) {
-    auto v = f["joints"].numbers(numJoints());
-    q.joints = Eigen::Map<Eigen::VectorXd>(v.data(), numJoints());
+    const YamlField list = f["joints"];
+    list.numbers(numJoints());  // the count, with its message
+    for (int j = 0; j < numJoints(); ++j) q.joints[j] = list.at(j).angle();
   }
   for (const char* key : {"joints_rad", "joints_deg"}) {
     if (!f.has(key)) continue;
@@ -364,7 +365,7 @@ Configuration RobotModel::readConfiguration(const YamlField& f) const {
     for (const auto& name : map.keys()) {
       int j = jointIndex(name);
       if (j < 0) throw FormatError(map.file(), map.path() + "." + name, "a joint name of the robot");
-      q.joints[j] = map[name].number() * scale;
+      q.joints[j] = (scale == 1.0 ? map[name].angle() : map[name].degrees()) * scale;
     }
   }
   return q;

@@ -105,8 +105,8 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
     if (c.has("x")) cs.placement.x = c["x"].number();
     if (c.has("y")) cs.placement.y = c["y"].number();
     if (c.has("theta") && c.has("theta_deg")) c.fail("at most one of theta and theta_deg");
-    if (c.has("theta")) cs.placement.theta = c["theta"].number();
-    if (c.has("theta_deg")) cs.placement.theta = c["theta_deg"].number() * M_PI / 180;
+    if (c.has("theta")) cs.placement.theta = c["theta"].angle();
+    if (c.has("theta_deg")) cs.placement.theta = c["theta_deg"].degrees() * M_PI / 180;
     sc.start_stance.push_back(cs);
   }
   if (sc.start_stance.empty()) contacts.fail("at least one contact");
