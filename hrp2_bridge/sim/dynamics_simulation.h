@@ -43,7 +43,7 @@ struct DynamicsOptions {
   // local error), steps at most max_step. SemiExplicitEuler2 (velocities
   // first, then positions with them; two evaluations a step) is made for
   // stiff contact: on step_forward it takes the same verdicts and figures as
-  // Runge-Kutta-Merson at a third of its wall time.
+  // Runge-Kutta-Merson in half its wall time.
   std::string integrator = "semi-explicit-euler2";
   double accuracy = 1e-3;
   double max_step = 0.005;           // s
