@@ -3,7 +3,10 @@
 // velocity feed-forward, the model's velocity limits; hrp2_bridge/sim/),
 // publishes HRP2_STATE at the controller rate (joints, velocities, base pose,
 // contact wrenches from the quasi-static model). Fault options for tests:
-// latency, dropped commands, a freeze (the controller hangs).
+// latency, dropped commands, a freeze (the controller hangs). With
+// --dynamics the tracked joints are the references of a dynamics simulation
+// (hrp2_bridge/sim/dynamics_simulation.h): free base, PD servos, compliant
+// contact; the state is the simulated robot's.
 // Exit: 0 on SIGINT/SIGTERM or at --duration, 2 bad input, 3 LCM failure.
 #include <CLI/CLI.hpp>
 
@@ -17,6 +20,7 @@
 #include "acyclic/hrp2_state_t.hpp"
 #include "channels.hpp"
 #include "hrp2_bridge/periodic_loop.h"
+#include "hrp2_bridge/sim/dynamics_simulation.h"
 #include "hrp2_bridge/sim/simulated_controller.h"
 #include "hrp2_bridge/trajectory_file.h"
 #include "processes/lcm_process.h"
@@ -58,12 +62,15 @@ int main(int argc, char** argv) {
       "real controller it refuses (and counts) a command beyond the joint position or velocity limits and\n"
       "never moves a joint past its limits (joints are kinematic: no torques, so no torque limit); when the\n"
       "command stream stops for --hold-after-missed periods it holds the last commanded posture.\n"
+      "--dynamics: the robot is a dynamics simulation instead (Simbody: free base, the tracked joints as\n"
+      "references of PD servos, compliant contact with the scene; see acyclic-simulate); the default is the\n"
+      "kinematic robot above.\n"
       "Exit status: 0 on SIGINT/SIGTERM or after --duration, 2 bad input, 3 LCM failure."};
   std::string scenario_path, start_trajectory, url = proc::defaultLcmUrl();
   hrp2::SimOptions o;
   double wrench_period = 0.05;
   int rt_priority = 20;
-  bool servo_off = false;
+  bool servo_off = false, dynamics = false;
   double duration = 0;
   app.add_option("--scenario", scenario_path, "scenario (robot, scene, start configuration)")->required();
   app.add_option("--start-trajectory", start_trajectory,
@@ -78,6 +85,8 @@ int main(int argc, char** argv) {
   app.add_option("--wrench-period", wrench_period,
                  "contact wrenches (quasi-static LP, off the control loop) every this many s (default 0.05)")
       ->check(CLI::PositiveNumber);
+  app.add_flag("--dynamics", dynamics,
+               "dynamics simulation: the base is free and falls if the motion does not hold it (default: kinematic)");
   app.add_flag("--servo-off", servo_off, "report the servos off (the bridge must refuse to start)");
   app.add_option("--hold-after-missed", o.hold_after_missed,
                  "hold the last commanded posture (no velocity feed-forward, the base where it stands) after this\n"
@@ -96,6 +105,7 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<hrp2::SimulatedController> sim;
   std::unique_ptr<hrp2::ContactForces> forces;
+  std::unique_ptr<hrp2::DynamicsSimulator> dyn;
   try {
     o.validate();
     Scenario sc = Scenario::load(scenario_path);
@@ -103,6 +113,12 @@ int main(int argc, char** argv) {
     if (!start_trajectory.empty()) start = hrp2::loadTrajectoryFile(start_trajectory, scenario_path).trajectory.samples.at(0).q;
     sim = std::make_unique<hrp2::SimulatedController>(sc.robot, start, o);
     forces = std::make_unique<hrp2::ContactForces>(sc.robot, sc.scene);
+    if (dynamics) {
+      std::vector<std::pair<int, int>> pairs;  // every allowed spot may touch every allowed surface
+      for (int spot : sc.allowed_spots)
+        for (int surface : sc.allowed_surfaces) pairs.push_back({spot, surface});
+      dyn = std::make_unique<hrp2::DynamicsSimulator>(sc, start, hrp2::DynamicsOptions{}, pairs);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: %s\n", kName, e.what());
     return 2;
@@ -120,6 +136,16 @@ int main(int argc, char** argv) {
   std::mutex mutex;
   long bad_messages = 0;
   const int n = static_cast<int>(sim->state().q.size());
+  // The robot's state: the kinematic controller's, or the dynamics' driven by it.
+  auto robotState = [&] {
+    hrp2::SimState st = sim->state();
+    if (dyn) {
+      st.configuration = dyn->configuration();
+      st.q = st.configuration.joints;
+      st.dq = dyn->jointVelocities();
+    }
+    return st;
+  };
 
   struct Handler {
     std::function<void(const lcm::ReceiveBuffer*)> f;
@@ -173,7 +199,7 @@ int main(int argc, char** argv) {
       Configuration q;
       {
         std::lock_guard<std::mutex> lock(mutex);
-        q = sim->state().configuration;
+        q = robotState().configuration;
       }
       bool eq = false;
       auto w = forces->compute(q, &eq);
@@ -185,7 +211,7 @@ int main(int argc, char** argv) {
       every.wait();
     }
   });
-  proc::log(kName, "running at " + std::to_string(o.dt) + " s, " + rt_note +
+  proc::log(kName, "running at " + std::to_string(o.dt) + " s, " + (dyn ? "dynamics, " : "") + rt_note +
                        (o.latency > 0 ? ", latency " + std::to_string(o.latency) + " s" : "") +
                        (o.drop_rate > 0 ? ", dropping " + std::to_string(o.drop_rate) : "") +
                        (o.freeze_after >= 0 ? ", freezing " + std::to_string(o.freeze_after) + " s after the first command" : ""));
@@ -202,8 +228,14 @@ int main(int argc, char** argv) {
     {
       std::lock_guard<std::mutex> lock(mutex);
       sim->step(now);
+      if (dyn && !sim->frozen(now)) {
+        // Reached linearly over a period: the servo's reference stays continuous.
+        const hrp2::SimState ref = sim->state();
+        dyn->setReference(ref.q, ref.dq, o.dt);
+        dyn->advanceTo((now - t0) * 1e-6);
+      }
       if (!sim->frozen(now)) {
-        hrp2::SimState st = sim->state();
+        hrp2::SimState st = robotState();
         std::lock_guard<std::mutex> wlock(wrench_mutex);
         st.wrenches = wrenches;
         st.equilibrium = equilibrium;

@@ -42,7 +42,7 @@ void say(const std::string& s) {
 template <class Msg>
 std::vector<char> canonical(Msg m) {
   m.utime = 0;
-  if constexpr (std::is_same_v<Msg, plan_t>) m.seconds = 0;
+  if constexpr (std::is_same_v<Msg, plan_t>) m.seconds = 0, m.base_path.clear();  // where the files were, not the plan
   std::vector<char> b(m.getEncodedSize());
   m.encode(b.data(), 0, static_cast<int>(b.size()));
   return b;
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Replays a recorded pipeline run (an LCM log written by acyclic-launch or lcm-logger) into fresh\n"
       "acyclic-planner and acyclic-interpolator processes and checks that their answers equal the logged\n"
-      "ones (all but send times and wall-time figures). Exit status: 0 identical, 1 a difference or no\n"
+      "ones (all but send times, wall-time figures and the folder the files were in). Exit status: 0 identical, 1 a difference or no\n"
       "answer, 2 bad input. Run it where LCM multicast works (scripts/netns-run)."};
   std::string log_path, url = proc::defaultLcmUrl(), bin_dir = executableDir();
   double timeout_s = 300;
@@ -96,6 +96,11 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--bin-dir", bin_dir, "where the acyclic-* executables are (default: beside this one)");
   app.add_option("--timeout", timeout_s, "seconds to wait for each answer")->capture_default_str();
+  std::string base_path;
+  app.add_option("--base-path", base_path,
+                 "resolve the logged scenarios' relative paths (robot, scene) against this folder instead of the one\n"
+                 "they were recorded in: a log recorded in another checkout or on another machine")
+      ->check(CLI::ExistingDirectory);
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   // What the log holds.
@@ -170,9 +175,11 @@ int main(int argc, char** argv) {
         continue;
       }
       ear.want = req.request_id;
+      request_t sent = req;
+      if (!base_path.empty()) sent.base_path = fs::absolute(base_path).lexically_normal().string();
       ear.plan.reset();
       ear.trajectory.reset();
-      bus.publish(channels::kRequest, req);
+      bus.publish(channels::kRequest, sent);
       waitFor([&] { return ear.plan.has_value(); }, "plan for request " + std::to_string(req.request_id));
       const bool same = canonical(*ear.plan) == canonical(logged->second);
       differences += !same;

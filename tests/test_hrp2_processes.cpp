@@ -616,3 +616,27 @@ TEST_F(Hrp2Processes, ABridgeKilledMidMotionLeavesTheSimulatorHoldingTheLastComm
   EXPECT_LT(dq_max, 1e-3);
   EXPECT_EQ(stop(s), 0) << logs();
 }
+
+// The simulator's dynamic mode: the same stream drives a dynamics simulation
+// (free base, PD servos, compliant contact); the seated robot moves its arm
+// and stays seated, and the state is the simulated robot's.
+TEST_F(Hrp2Processes, DynamicsModeFollowsTheStreamWithAFreeBase) {
+  const Trajectory tr = armMotion(1.5, -0.4);
+  const std::string file = trajectoryFile(tr, "arm.json");
+  Child& s = sim({"--dynamics"});
+  Child& b = spawn("acyclic-hrp2-bridge", {"--trajectory", file, "--config", tolerantConfig()});
+  EXPECT_EQ(wait(b, 30), 0) << logs();
+  serveFor(0.3);
+  ASSERT_FALSE(heard_.states.empty());
+  const hrp2_state_t& last = heard_.states.back();
+  // The arm's servo ends near the end (its own error under gravity), not exactly there.
+  const double arm_error = std::abs(last.q[16] - tr.samples.back().q.joints[16]);
+  EXPECT_LT(arm_error, 0.02);
+  EXPECT_GT(arm_error, 0.0);
+  // The base is free: it settled on the compliant seat and feet, a little lower than planned, and stayed.
+  const Eigen::Vector3d base(last.base_position[0], last.base_position[1], last.base_position[2]);
+  EXPECT_LT((base - chair().start.base_position).norm(), 0.01);
+  EXPECT_NE(base, chair().start.base_position);
+  EXPECT_NE(test::readFile(s.log).find("dynamics"), std::string::npos);
+  EXPECT_EQ(stop(s), 0) << logs();
+}

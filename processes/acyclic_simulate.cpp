@@ -1,0 +1,113 @@
+// acyclic-simulate: executes a trajectory in a dynamics simulation (Simbody
+// multibody dynamics, free base, PD-servoed joints, compliant contact;
+// hrp2_bridge/sim/dynamics_simulation.h) and reports per phase base drift
+// and tilt, each contact's slip, lift-off and force against the plan's,
+// tracking error, and the verdict.
+// Exit status: 0 executed, 1 fell or slipped, 2 bad input.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <unistd.h>
+
+#include "hrp2_bridge/sim/dynamics_simulation.h"
+#include "hrp2_bridge/trajectory_file.h"
+#include "processes/command_line.h"
+
+int main(int argc, char** argv) {
+  using namespace acyclic;
+  CLI::App app{
+      "Executes a trajectory in a dynamics simulation (Simbody multibody dynamics, not kinematics): the\n"
+      "base is free, each joint a PD servo toward the trajectory's q with its dq as feed-forward (gains from\n"
+      "the effort limits, torque clamped to them), contacts compliant Hunt-Crossley spheres at the contact\n"
+      "spots' polygon corners against the scene's surfaces with their friction. Prints per phase the base\n"
+      "drift and tilt against the plan, each contact's slip, lift-off and force against the quasi-static\n"
+      "plan's, the worst joint tracking error, and the verdict (executed / fell / slipped, time, reason).\n"
+      "Progress on stderr when it is a terminal.\n"
+      "Exit status: 0 executed, 1 fell or slipped, 2 bad input."};
+  std::string scenario_path, trajectory_path, report_path;
+  hrp2::DynamicsOptions o;
+  bool quiet = false;
+  app.add_option("scenario", scenario_path, "scenario file (format acyclic.scenario/1)")->required();
+  app.add_option("--trajectory", trajectory_path, "trajectory file (format acyclic.trajectory/1)")->required();
+  app.add_option("--report", report_path, "write the report as JSON (format acyclic.simulation/1) to this file");
+  app.add_option("--slip-bound", o.slip_bound, "a supporting contact slipping more over its phase: slipped, m (default 0.01)");
+  app.add_option("--base-bound", o.base_bound, "acceptance: base within this of the plan, m (default 0.02)");
+  app.add_option("--settle", o.settle, "hold the last reference this long after the end, s (default 0.5)");
+  app.add_option("--accuracy", o.accuracy, "integrator accuracy, relative local error (default 1e-3)");
+  app.add_option("--integrator", o.integrator, "semi-explicit-euler2 (default), rk-merson or rk3");
+  app.add_option("--full-torque-error", o.full_torque_error,
+                 "servo stiffness: a joint's whole effort limit at this error, rad (default 0.01)");
+  app.add_option("--transition-velocity", o.transition_velocity,
+                 "friction's stiction regularization velocity, m/s (default 0.01)");
+  app.add_flag("-q,--quiet", quiet, "print only the verdict");
+  ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
+
+  hrp2::LoadedTrajectory loaded;
+  try {
+    o.validate();
+    loaded = hrp2::loadTrajectoryFile(trajectory_path, scenario_path);
+    if (loaded.trajectory.samples.size() < 2) throw std::invalid_argument(trajectory_path + ": field 'samples': at least two samples");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "acyclic-simulate: %s\n", e.what());
+    return 2;
+  }
+  const Scenario& sc = loaded.scenario;
+  const Trajectory& tr = loaded.trajectory;
+  const bool tty = isatty(fileno(stderr));
+  hrp2::SimulationProgress progress;
+  if (tty)
+    progress = [](double t, double total) {
+      std::fprintf(stderr, "\r  simulated %6.2f / %.2f s", t, total);
+      if (t >= total - 1e-9) std::fprintf(stderr, "\n");
+      std::fflush(stderr);
+    };
+  hrp2::SimulationReport r;
+  try {
+    r = hrp2::simulate(sc, tr, o, progress);
+  } catch (const std::exception& e) {
+    if (tty) std::fprintf(stderr, "\n");
+    std::fprintf(stderr, "acyclic-simulate: the simulation failed: %s\n", e.what());
+    return 2;
+  }
+  if (tty) std::fprintf(stderr, "\n");
+  if (!quiet) {
+    std::printf("acyclic-simulate: %s, %zu samples (%.2f s), %zu phases\n", trajectory_path.c_str(), tr.samples.size(),
+                tr.duration(), tr.phases.size());
+    for (const auto& p : r.phases) {
+      std::printf("phase %d [%.2f, %.2f] s: base drift %.1f mm (end %.1f), tilt %.2f deg, tracking %.2f deg (%s)\n",
+                  p.phase, p.t_start, p.t_end, 1e3 * p.base_drift, 1e3 * p.base_drift_end, p.tilt * 180 / M_PI,
+                  p.tracking * 180 / M_PI, p.tracking_joint.c_str());
+      for (const auto& c : p.contacts) {
+        std::printf("  %-10s @ %-12s %-10s slip %5.1f mm, lift %5.1f mm, unloaded %.2f s%s, force (%.0f %.0f %.0f) N",
+                    c.spot.c_str(), c.surface.c_str(), c.supporting ? "supporting" : "touching", 1e3 * c.slip,
+                    1e3 * c.lift, c.unloaded_time, c.left_surface ? ", LEFT THE SURFACE" : "", c.force.x(),
+                    c.force.y(), c.force.z());
+        if (c.plan_force_known)
+          std::printf(", plan (%.0f %.0f %.0f) N\n", c.plan_force.x(), c.plan_force.y(), c.plan_force.z());
+        else
+          std::printf(", plan: none\n");
+      }
+    }
+    std::printf("worst: slip %.1f mm (%s), base drift %.1f mm, tracking %.2f deg (%s)\n", 1e3 * r.worst_slip,
+                r.worst_slip_contact.c_str(), 1e3 * r.worst_base_drift, r.worst_tracking * 180 / M_PI,
+                r.worst_tracking_joint.c_str());
+    std::printf("integrator: %s, accuracy %g, %ld steps (mean %.3g ms)\n", o.integrator.c_str(), o.accuracy,
+                r.integrator_steps, 1e3 * r.mean_step);
+    std::printf("time: %.2f s simulated in %.2f s wall (%.2fx real time)\n", r.motion_time, r.wall_time,
+                r.wall_time > 0 ? r.motion_time / r.wall_time : 0.0);
+    std::printf("acceptance: %s (no fall, supporting slip < %.0f mm, base within %.0f mm of the plan)\n",
+                r.executed() && r.base_within_bound ? "yes" : "no", 1e3 * o.slip_bound, 1e3 * o.base_bound);
+  }
+  std::printf("verdict: %s at %.3f s%s%s\n", hrp2::toString(r.verdict), r.verdict_time, r.reason.empty() ? "" : ": ",
+              r.reason.c_str());
+  if (!report_path.empty()) {
+    try {
+      hrp2::writeReport(r, report_path);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "acyclic-simulate: %s\n", e.what());
+      return 2;
+    }
+  }
+  return r.executed() ? 0 : 1;
+}

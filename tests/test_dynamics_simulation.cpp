@@ -1,0 +1,234 @@
+// The dynamics simulation of executing a trajectory (Simbody dynamics, PD
+// servos, compliant contact): a robot whose CoM is pushed beyond its feet
+// falls; standing, leaning within the feet and step_forward's weight shift
+// (planned and interpolated here) execute without falling and with little
+// slip; the acyclic-simulate executable's exit statuses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hrp2_bridge/sim/dynamics_simulation.h"
+#include "interpolator/interpolator.h"
+#include "planner/model/kinematics.h"
+#include "planner/search/planner_parameters.h"
+#include "test_support.h"
+
+using namespace acyclic;
+
+namespace {
+
+// Slip allowed to a supporting contact over a phase in these tests: a
+// tenth of the acceptance bound (1 cm), so that a regression in the contact
+// model shows before the chair's acceptance fails.
+constexpr double kSlipBound = 0.002;
+constexpr double kBaseBound = 0.02;
+
+const Scenario& floorScenario() {
+  static Scenario sc = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml"));
+  return sc;
+}
+
+// Standing on both feet, the whole body leaning forward about the ankles by
+// `lean` rad (reached linearly over 1 s, then held for 1 s): the base turns
+// about the ankles' midpoint and the ankle pitch joints turn back, so the
+// feet stay flat on the floor in the plan.
+Trajectory leaningTrajectory(const Scenario& sc, double lean) {
+  const RobotModel& m = *sc.robot;
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(sc.start);
+  const int r_ankle = m.jointIndex("RLEG_JOINT4"), l_ankle = m.jointIndex("LLEG_JOINT4");
+  const Eigen::Vector3d pivot = 0.5 * (kin.jointOrigin(r_ankle) + kin.jointOrigin(l_ankle));
+  Trajectory tr;
+  tr.dt = 0.005;
+  TrajectoryPhase ph;
+  ph.contacts = sc.start_stance;
+  const int n = 400;
+  ph.t_end = n * tr.dt;
+  tr.phases.push_back(ph);
+  for (int k = 0; k <= n; ++k) {
+    const double s = std::min(1.0, k / 200.0), a = lean * s;
+    const double rate = k < 200 ? lean / 1.0 : 0.0;
+    const Eigen::AngleAxisd R(a, Eigen::Vector3d::UnitY());
+    TrajectorySample x;
+    x.t = k * tr.dt;
+    x.q = sc.start;
+    x.q.base_position = pivot + R * (sc.start.base_position - pivot);
+    x.q.base_orientation = Eigen::Quaterniond(R) * sc.start.base_orientation;
+    x.q.joints[r_ankle] -= a;
+    x.q.joints[l_ankle] -= a;
+    x.dq = Eigen::VectorXd::Zero(m.numJoints());
+    x.dq[r_ankle] = x.dq[l_ankle] = -rate;
+    tr.samples.push_back(x);
+  }
+  return tr;
+}
+
+Trajectory plannedTrajectory(const Scenario& sc) {
+  const PlanningResult p = ContactPlanner(sc, plannerParameters(sc)).plan();
+  EXPECT_TRUE(p.solved()) << p.reason;
+  const InterpolationResult t = interpolate(p.plan, sc, {});
+  EXPECT_TRUE(t.success()) << t.reason;
+  return t.trajectory;
+}
+
+void expectExecuted(const hrp2::SimulationReport& r) {
+  EXPECT_EQ(r.verdict, hrp2::SimulationReport::Verdict::Executed) << r.reason;
+  EXPECT_LT(r.worst_slip, kSlipBound) << r.worst_slip_contact;
+  EXPECT_LT(r.worst_base_drift, kBaseBound);
+  for (const auto& p : r.phases)
+    for (const auto& c : p.contacts)
+      if (c.supporting) {
+        EXPECT_FALSE(c.left_surface) << c.spot << " phase " << p.phase;
+        // A supporting contact carries load: the simulated force is not nil.
+        EXPECT_GT(c.force.z(), 1.0) << c.spot << " phase " << p.phase;
+      }
+}
+
+}  // namespace
+
+// The simulator builds its own Simbody system from the model: the same
+// masses and joint placements as the planner's (its centre of mass at a
+// posture with every joint bent).
+TEST(DynamicsSimulation, ModelMatchesThePlannersModel) {
+  const Scenario& sc = floorScenario();
+  Configuration q = sc.robot->posture("sitting");
+  for (int j = 0; j < q.joints.size(); ++j) q.joints[j] += 0.1 * std::sin(j + 1.0);
+  q.base_position = Eigen::Vector3d(0.3, -0.2, 1.0);
+  q.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+  const hrp2::DynamicsSimulator sim(sc, q, {});
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(q);
+  EXPECT_LT((sim.centerOfMass() - kin.centerOfMass()).norm(), 1e-9);
+  const Configuration back = sim.configuration();
+  EXPECT_LT((back.joints - q.joints).norm(), 1e-12);
+  EXPECT_LT((back.base_position - q.base_position).norm(), 1e-12);
+}
+
+TEST(DynamicsSimulation, StandingStillHoldsItsPostureAndCarriesItsWeight) {
+  const Scenario& sc = floorScenario();
+  const Trajectory tr = leaningTrajectory(sc, 0.0);
+  hrp2::DynamicsOptions o;
+  o.settle = 0;
+  const hrp2::SimulationReport r = hrp2::simulate(sc, tr, o);
+  expectExecuted(r);
+  ASSERT_EQ(r.phases.size(), 1u);
+  // The two soles carry the weight, as the quasi-static plan says.
+  const double weight = sc.robot->totalMass() * 9.81;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), plan = Eigen::Vector3d::Zero();
+  for (const auto& c : r.phases[0].contacts) {
+    sum += c.force;
+    ASSERT_TRUE(c.plan_force_known);
+    plan += c.plan_force;
+  }
+  EXPECT_NEAR(sum.z(), weight, 0.02 * weight);
+  EXPECT_NEAR(plan.z(), weight, 1e-3 * weight);
+  EXPECT_LT(r.phases[0].tilt, 0.02);
+}
+
+TEST(DynamicsSimulation, LeaningWithinTheFeetStaysUp) {
+  // 3 degrees: the CoM about 4 cm ahead of the ankles, inside the soles (14 cm).
+  const Scenario& sc = floorScenario();
+  const hrp2::SimulationReport r = hrp2::simulate(sc, leaningTrajectory(sc, 3 * M_PI / 180));
+  expectExecuted(r);
+}
+
+TEST(DynamicsSimulation, CentreOfMassBeyondTheToesFalls) {
+  // 20 degrees: the CoM about 28 cm ahead of the ankles, twice the toes' 14 cm.
+  const Scenario& sc = floorScenario();
+  hrp2::DynamicsOptions o;
+  o.settle = 2.0;
+  const hrp2::SimulationReport r = hrp2::simulate(sc, leaningTrajectory(sc, 20 * M_PI / 180), o);
+  EXPECT_EQ(r.verdict, hrp2::SimulationReport::Verdict::Fell) << r.reason;
+  EXPECT_GT(r.verdict_time, 0.5);  // the lean has to build up first
+  EXPECT_LT(r.motion_time, 4.0);   // stopped at the fall
+  EXPECT_NE(r.reason.find("tilted"), std::string::npos) << r.reason;
+}
+
+// Up to the first single support: both feet on the floor while the CoM moves
+// over the left foot.
+TEST(DynamicsSimulation, StepForwardsWeightShiftExecutes) {
+  const Scenario& sc = floorScenario();
+  Trajectory tr = plannedTrajectory(sc);
+  ASSERT_GE(tr.phases.size(), 2u);
+  ASSERT_EQ(tr.phases[0].contacts.size(), 2u);
+  std::size_t k = 0;
+  while (k < tr.samples.size() && tr.samples[k].phase == 0) ++k;
+  tr.samples.resize(k);
+  tr.phases.resize(1);
+  const hrp2::SimulationReport r = hrp2::simulate(sc, tr);
+  expectExecuted(r);
+  ASSERT_EQ(r.phases.size(), 1u);
+  // Halfway, the left foot already carries more of the weight than the right.
+  double left = 0, right = 0;
+  for (const auto& c : r.phases[0].contacts) (c.spot == "l_sole" ? left : right) = c.force.z();
+  EXPECT_GT(left, right);
+  EXPECT_NEAR(left + right, sc.robot->totalMass() * 9.81, 0.05 * sc.robot->totalMass() * 9.81);
+}
+
+// Disabled: both plans fall in this simulation, which has no stabilizer.
+// step_forward falls in its first single support (phase 2): the plan keeps
+// the CoM 3-5 mm inside the left sole's inner edge while the right sole,
+// which the position-servoed legs (not the plan) still load with about
+// 190 N when it is released, lifts; the robot rolls over that edge.
+// sit_down falls backwards at the end of its first phase, both feet down:
+// the plan brings the CoM within 5 mm of the heels' edge, less than the
+// servos' and the soles' compliance tilts the robot (it falls so when played
+// four times slower too). Enable once plans keep a CoM margin.
+TEST(DynamicsSimulation, DISABLED_StepForwardExecutes) {
+  const Scenario& sc = floorScenario();
+  const Trajectory tr = plannedTrajectory(sc);
+  const hrp2::SimulationReport r = hrp2::simulate(sc, tr);
+  expectExecuted(r);
+  EXPECT_EQ(r.phases.size(), tr.phases.size());
+}
+
+TEST(DynamicsSimulation, DISABLED_SitDownExecutes) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
+  const Trajectory tr = plannedTrajectory(sc);
+  const hrp2::SimulationReport r = hrp2::simulate(sc, tr);
+  expectExecuted(r);
+  // Seated at the end: both thighs on the seat carry load.
+  double thighs = 0;
+  for (const auto& c : r.phases.back().contacts)
+    if (c.surface == "chair_seat") thighs += c.force.z();
+  EXPECT_GT(thighs, 50.0);
+}
+
+TEST(DynamicsSimulation, ReportIsJson) {
+  hrp2::SimulationReport r;
+  r.verdict = hrp2::SimulationReport::Verdict::Slipped;
+  r.reason = "r_sole on floor slipped";
+  hrp2::PhaseOutcome p;
+  p.contacts.push_back({});
+  r.phases.push_back(p);
+  const std::string j = hrp2::reportToJson(r);
+  EXPECT_NE(j.find("\"verdict\": \"slipped\""), std::string::npos) << j;
+  EXPECT_NE(j.find("\"plan_force\": null"), std::string::npos) << j;
+  EXPECT_NE(j.find("acyclic.simulation/1"), std::string::npos) << j;
+}
+
+TEST(SimulateProcess, HelpBadInputAndAFall) {
+  const std::string exe = test::binaryPath("processes/acyclic-simulate");
+  const auto help = test::runProcess(exe + " --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.output.find("Exit status: 0 executed"), std::string::npos) << help.output;
+  test::TempDir dir;
+  const std::string scenario = test::sourcePath("models/scenarios/step_forward.yaml");
+  // A trajectory file with a bad field: exit 2, the file and the field named.
+  const std::string bad = dir.write("bad.json", R"({"format": "acyclic.trajectory/1", "dt": "fast"})");
+  const auto b = test::runProcess(exe + " " + scenario + " --trajectory " + bad);
+  EXPECT_EQ(b.status, 2) << b.output;
+  EXPECT_NE(b.output.find("bad.json"), std::string::npos) << b.output;
+  const auto missing = test::runProcess(exe + " " + scenario + " --trajectory " + dir.path() + "/none.json");
+  EXPECT_EQ(missing.status, 2) << missing.output;
+  // A fall: exit 1, the verdict printed and written.
+  const Scenario& sc = floorScenario();
+  Trajectory tr = leaningTrajectory(sc, 20 * M_PI / 180);
+  tr.scenario = scenario;
+  writeTrajectory(tr, sc, dir.path() + "/lean.json");
+  const auto f = test::runProcess(exe + " " + scenario + " --trajectory " + dir.path() + "/lean.json --settle 2 --report " +
+                                  dir.path() + "/r.json");
+  EXPECT_EQ(f.status, 1) << f.output;
+  EXPECT_NE(f.output.find("verdict: fell"), std::string::npos) << f.output;
+  EXPECT_NE(test::readFile(dir.path() + "/r.json").find("\"verdict\": \"fell\""), std::string::npos);
+}
