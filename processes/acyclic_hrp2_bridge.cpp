@@ -268,19 +268,10 @@ int main(int argc, char** argv) {
 
   std::atomic<bool> lcm_failed{false}, quit{false};
   std::thread receiver([&] {
-    while (!proc::stopRequested() && !quit) {
-      int r = 0;
-      try {
-        r = bus->lcm().handleTimeout(20);
-      } catch (const std::exception& e) {
-        // A handler's failure is one message lost, never the bridge.
-        status.error(-1, std::string("a message's handler failed: ") + e.what());
-      }
-      if (r < 0 && !proc::stopRequested()) {
-        lcm_failed = true;
-        break;
-      }
-    }
+    // A handler's failure is one message lost, never the process.
+    lcm_failed = proc::spin(*bus, {}, [&] { return quit.load(); }, 20, [&](const std::string& what) {
+                   status.error(-1, "a message's handler failed: " + what);
+                 }) != 0;
   });
   std::thread intake_thread([&] {
     hrp2::setBackgroundPriority(rt_priority > 0);

@@ -174,18 +174,10 @@ int main(int argc, char** argv) {
 
   std::atomic<bool> lcm_failed{false}, quit{false};
   std::thread receiver([&] {
-    while (!proc::stopRequested() && !quit) {
-      int r = 0;
-      try {
-        r = bus->lcm().handleTimeout(20);
-      } catch (const std::exception& e) {
-        status.error(-1, std::string("a message's handler failed: ") + e.what());
-      }
-      if (r < 0 && !proc::stopRequested()) {
-        lcm_failed = true;
-        break;
-      }
-    }
+    // A handler's failure is one message lost, never the process.
+    lcm_failed = proc::spin(*bus, {}, [&] { return quit.load(); }, 20, [&](const std::string& what) {
+                   status.error(-1, "a message's handler failed: " + what);
+                 }) != 0;
   });
   // Contact wrenches: the LP takes milliseconds, so it runs on its own thread
   // at its own rate and the control loop attaches the latest result.
