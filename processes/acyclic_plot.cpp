@@ -46,8 +46,8 @@ std::vector<PlannerProgressPoint> readProgress(const std::string& path, const st
 int main(int argc, char** argv) {
   CLI::App app{
       "Writes the figures of a run as SVG into DIR:\n"
-      "  with --trajectory: joint_angles.svg, joint_velocities.svg (with limits), stability.svg (friction margin\n"
-      "  and worst torque ratio of the independent quasi-static check at each frame);\n"
+      "  with --trajectory: joint_angles.svg, joint_velocities.svg (with limits), stability.svg (friction margin,\n"
+      "  worst ||f_t|| / (mu f_n) and worst torque ratio of the independent quasi-static check at each frame);\n"
       "  with --log (a run's run.lcmlog): planner_progress.svg (best potential, nodes generated, posture calls\n"
       "  over time, from the planner's ACYCLIC_PROGRESS messages).\n"
       "Exit: 0 written, 1 cannot write or no progress message in the log, 2 bad input."};

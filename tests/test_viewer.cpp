@@ -220,8 +220,15 @@ TEST_F(Viewer, FiguresHaveAPanelPerJointWithItsLimitsAndTheMarginAlongTheTraject
     for (double y : p.series[0].y) EXPECT_LE(std::abs(y), p.lines[0].y + 1e-6) << p.title;
   const auto frames = trajectoryFrames(sc_, tr_, 25);
   const PlotFigure stab = stabilityFigure(sc_, frames);
-  ASSERT_EQ(stab.panels.size(), 2u);
+  ASSERT_EQ(stab.panels.size(), 3u);
   EXPECT_EQ(stab.panels[0].series[0].y.size(), frames.size());
+  // The check's forces are inside the Coulomb cone at every frame, and friction is used.
+  double worst_cone = 0;
+  for (double y : stab.panels[1].series[0].y) {
+    EXPECT_LE(y, 1.0 + 1e-9);
+    if (std::isfinite(y)) worst_cone = std::max(worst_cone, y);
+  }
+  EXPECT_GT(worst_cone, 0.0);
   const std::string svg = renderSvg(angles);
   EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
   std::size_t polylines = 0;

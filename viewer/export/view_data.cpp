@@ -72,6 +72,7 @@ void applyStatics(const QuasiStaticReport& r, ViewPosture& v) {
   v.feasible = r.feasible;
   v.margin = r.margin;
   v.worst_torque_ratio = r.worst_torque_ratio;
+  v.worst_cone_ratio = r.worst_cone_ratio;
 }
 
 // The check's corners and forces of stance contact c (the report holds one

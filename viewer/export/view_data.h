@@ -39,6 +39,7 @@ struct ViewPosture {
   bool feasible = false;
   double margin = 0;
   double worst_torque_ratio = 0;
+  double worst_cone_ratio = 0;  // max ||f_t|| / (mu f_n) of the check's forces (LP 2): at most 1, in the cone
 };
 
 // One robot collision shape: its link and its index among the link's shapes.

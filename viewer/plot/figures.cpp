@@ -60,20 +60,27 @@ PlotFigure stabilityFigure(const Scenario& sc, const std::vector<ViewPosture>& f
   fig.title = sc.name + ": stability along the trajectory (independent quasi-static check)";
   fig.panel_width = 760;
   fig.panel_height = 220;
-  PlotPanel margin{"friction margin: min over contact corners of mu f_n - |f_t| (LP 1)", "t (s)", "N", {}, {}};
+  PlotPanel margin{"friction margin: least slack of a corner force to its friction pyramid's facets (LP 1)", "t (s)",
+                   "N", {}, {}};
+  PlotPanel cone{"worst ||f_t|| / (mu f_n) of the corner forces (LP 2): at most 1 inside the Coulomb cone", "t (s)",
+                 "ratio", {}, {}};
   PlotPanel torque{"worst joint torque / its limit (LP 2)", "t (s)", "ratio", {}, {}};
-  PlotSeries m{"margin", {}, {}, "#1f5fa8"}, r{"torque ratio", {}, {}, "#8e44ad"};
+  PlotSeries m{"margin", {}, {}, "#1f5fa8"}, c{"cone ratio", {}, {}, "#16a085"}, r{"torque ratio", {}, {}, "#8e44ad"};
   for (const auto& f : frames) {
     m.x.push_back(f.t);
     m.y.push_back(f.feasible ? f.margin : NAN);  // an infeasible frame leaves a gap
+    c.x.push_back(f.t);
+    c.y.push_back(f.feasible ? f.worst_cone_ratio : NAN);
     r.x.push_back(f.t);
     r.y.push_back(f.feasible ? f.worst_torque_ratio : NAN);
   }
   margin.series.push_back(std::move(m));
   margin.lines.push_back({0.0, "no margin", "#c0392b"});
+  cone.series.push_back(std::move(c));
+  cone.lines.push_back({1.0, "the cone", "#c0392b"});
   torque.series.push_back(std::move(r));
   torque.lines.push_back({1.0, "limit", "#c0392b"});
-  fig.panels = {std::move(margin), std::move(torque)};
+  fig.panels = {std::move(margin), std::move(cone), std::move(torque)};
   return fig;
 }
 
