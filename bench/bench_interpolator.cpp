@@ -3,8 +3,8 @@
 // n = 10 and 20 steps, with every sample verified (the default) and without
 // (knots and segment middles only: what the verification costs), on one
 // thread and on two (whether both give the same trajectory is printed); then
-// the independent trajectory check of the default n = 20 run. Figures quoted
-// in the README.
+// the independent trajectory check of the default n = 20 run. Figures in
+// docs/figures.md.
 // Usage: bench_interpolator [PLAN.json [SCENARIO]] [OPTIONS]; --help lists the options.
 //   Without a plan: plans models/scenarios/step_forward.yaml first. The
 //   scenario defaults to the plan's "scenario" field (relative to the plan's

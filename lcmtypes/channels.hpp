@@ -1,5 +1,5 @@
 #pragma once
-// Every LCM channel name of the pipeline, in one place (DESIGN.md section 2).
+// Every LCM channel name of the pipeline, in one place (docs/design.md section 2).
 // Command/status pairs: requests go down the pipeline, answers come back up.
 
 namespace acyclic::channels {

@@ -1,5 +1,5 @@
 // acyclic-check: checks a scenario's start stance, a plan, or a trajectory
-// against the validity contract (DESIGN.md section 9) and prints every check
+// against the validity contract (docs/design.md section 9) and prints every check
 // with its figures. Exit status: 0 valid, 1 a violation, 2 bad input.
 #include <CLI/CLI.hpp>
 
@@ -33,7 +33,7 @@ std::string describeStance(const acyclic::Scenario& sc, const std::vector<acycli
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Checks a scenario's start stance, or a plan, against Acyclic's validity contract (DESIGN.md\n"
+      "Checks a scenario's start stance, or a plan, against Acyclic's validity contract (docs/design.md\n"
       "section 9): joint limits, contacts, collisions and quasi-static equilibrium for every posture;\n"
       "for a plan also the sequence (start stance first, goal met last, one contact change per step);\n"
       "for a plan also the forces it reports (on the contacts' corners, inside the Coulomb cone,\n"

@@ -1,4 +1,4 @@
-// acyclic-launch: runs the whole pipeline on one machine (DESIGN.md section 2).
+// acyclic-launch: runs the whole pipeline on one machine (docs/design.md section 2).
 // Starts lcm-logger and the pipeline's processes, sends the scenario as one
 // ACYCLIC_REQUEST, follows progress, writes what comes back (plan,
 // trajectory) under the output folder, restarts a process that dies (and
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       "Everything started is stopped on exit and on Ctrl-C.\n"
       "Exit status: 0 every stage answered OK, 1 a stage failed or timed out, 2 bad input.\n"
       "Multicast: run it inside a private network namespace (scripts/run-pipeline does) or on a lab\n"
-      "network with ttl=1 (README, 'Across machines')."};
+      "network with ttl=1 (docs/design.md section 2, 'Across machines')."};
   std::string scenario_path, out_dir = "acyclic-run", url = proc::defaultLcmUrl(), bin_dir = executableDir();
   double timeout_s = 3600;  // the chair: planning takes minutes, and its motion plays in real time
   long seed = -1;

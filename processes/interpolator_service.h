@@ -1,6 +1,6 @@
 #pragma once
 // The trajectory interpolator on LCM: ACYCLIC_PLAN in, ACYCLIC_TRAJECTORY out,
-// with progress, status and cancellation (DESIGN.md section 2).
+// with progress, status and cancellation (docs/design.md section 2).
 #include <string>
 
 #include "interpolator/interpolator.h"

@@ -49,7 +49,7 @@ void log(const std::string& process, const std::string& message) {
 Bus::Bus(const std::string& url) : lcm_(url) {
   if (!lcm_.good()) throw std::runtime_error("LCM could not start on '" + url + "'" +
                                              (url.rfind("udpm", 0) == 0 || url.empty()
-                                                  ? " (udpm needs a multicast route: see the README)"
+                                                  ? " (udpm needs a multicast route: see docs/troubleshooting.md)"
                                                   : ""));
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// What every Acyclic process shares on LCM (DESIGN.md section 2): the URL,
+// What every Acyclic process shares on LCM (docs/design.md section 2): the URL,
 // SIGINT/SIGTERM handling, a thread-safe publisher, the 1 Hz status heartbeat
 // on ACYCLIC_STATUS with errors reported there and on stderr, and a loop that
 // serves LCM until a signal arrives.

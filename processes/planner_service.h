@@ -1,6 +1,6 @@
 #pragma once
 // The contact planner on LCM: ACYCLIC_REQUEST in, ACYCLIC_PLAN out, with
-// progress, status and cancellation (DESIGN.md section 2).
+// progress, status and cancellation (docs/design.md section 2).
 #include <string>
 
 #include "planner/search/contact_planner.h"

@@ -1,4 +1,4 @@
-// The trajectory interpolator (issue 5): the moving body's path, the time law,
+// The trajectory interpolator: the moving body's path, the time law,
 // and whole interpolations of small plans built here with the posture
 // generator (a foot step on the floor, a hand reaching the table and leaving
 // it, a step over a box that forces a repair), each output checked sample by
@@ -649,7 +649,7 @@ TEST(Interpolator, WeightShiftWithTheTrunkAlongTheTableEdge) {
 }
 
 TEST(Interpolator, WeightShiftUnderTheTableTopWithMoreClearance) {
-  // From the chair's plan of session 11: crouched between the chair and the
+  // From a chair plan (the generator's GJK distances): crouched between the chair and the
   // table, the abdomen 5 mm under the table top in both witnesses, the
   // weight goes from the right foot to the left while the waist moves 13 cm
   // sideways and up. At the collision margin the knots slide along the

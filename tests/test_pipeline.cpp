@@ -1,4 +1,4 @@
-// Process-level tests of the LCM pipeline (issue 6). Each test runs in its own
+// Process-level tests of the LCM pipeline. Each test runs in its own
 // private network namespace (tests/CMakeLists.txt wraps it with
 // scripts/netns-run), starts the real executables, talks to them over udpm,
 // and checks what they answer and the files and logs they write.

@@ -1,4 +1,4 @@
-// The viewer (issue 9): the data acyclic-view computes, the SVG figures, and
+// The viewer: the data acyclic-view computes, the SVG figures, and
 // the page itself in headless Chromium (Debian's chromium; the test FAILS when
 // it is missing: scripts/install-deps installs it).
 //
@@ -360,7 +360,7 @@ TEST(ViewerChair, TheWholeChairPlanInHeadlessChromium) {
 
 // The picture: a strip of the chair plan (a fixed file, so the picture does
 // not move when the planner changes), within a tolerance of the reference
-// (software rendering; README "Viewer" says how to remake the reference).
+// (software rendering; docs/design.md section 13 says how to remake the reference).
 TEST(ViewerChair, StripInHeadlessChromiumMatchesTheReference) {
   ASSERT_TRUE(haveChromium()) << chromiumMissing();
   TempDir out;

@@ -1,5 +1,5 @@
 #pragma once
-// The validity contract for a whole plan (DESIGN.md section 9): every stance's
+// The validity contract for a whole plan (docs/design.md section 9): every stance's
 // witness posture, the first stance is the scenario's start stance, the last
 // meets the goal, consecutive stances differ by one contact. The contact
 // forces a plan reports, where it reports them, are checked on their own

@@ -1,5 +1,5 @@
 #pragma once
-// Independent quasi-static feasibility check (DESIGN.md sections 6 and 9): an
+// Independent quasi-static feasibility check (docs/design.md sections 6 and 9): an
 // LP over contact forces at the corners of each supporting contact, built from
 // Simbody's gravity torques and station Jacobians only. It shares no code with
 // the posture generator beyond the model. Friction: the contract's pyramid
@@ -44,7 +44,7 @@ class QuasiStaticChecker {
   // At the kinematics' configuration, with the stance's supporting contacts.
   QuasiStaticReport check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const;
 
-  double residualTolerance() const { return 1e-6; }  // relative, DESIGN.md section 9
+  double residualTolerance() const { return 1e-6; }  // relative, docs/design.md section 9
 
   // Off by default. On, each LP starts from the last optimal basis of the
   // same size: checks along a trajectory follow each other closely, so the

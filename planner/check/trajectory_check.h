@@ -1,5 +1,5 @@
 #pragma once
-// The validity contract for a trajectory (DESIGN.md section 9), sample by
+// The validity contract for a trajectory (docs/design.md section 9), sample by
 // sample: every sample is a valid posture (the independent ValidityChecker)
 // with its phase's contacts, so contacts are held within 1 mm; joint velocities
 // are within their limits, both as stored and as the samples' finite

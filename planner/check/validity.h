@@ -1,5 +1,5 @@
 #pragma once
-// The validity contract of DESIGN.md section 9, checked part by part for one
+// The validity contract of docs/design.md section 9, checked part by part for one
 // posture and its stance. Each part reports what it checked, its worst figure
 // and every violation with its figure.
 //

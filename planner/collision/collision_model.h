@@ -1,7 +1,7 @@
 #pragma once
 // Signed distances between the robot and the scene and between listed robot
 // links, with witness points and gradients (FCL for the geometry, Simbody
-// Jacobians for the derivatives). DESIGN.md sections 5 and 6.
+// Jacobians for the derivatives). docs/design.md sections 5 and 6.
 #include <limits>
 #include <memory>
 #include <optional>

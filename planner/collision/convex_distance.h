@@ -8,7 +8,7 @@
 // Why not FCL's GJK (which CollisionModel uses for the independent check):
 // the posture generator evaluates 60-140 pairs at every iterate, and FCL's
 // libccd GJK took 1-3 us a pair (its own GJK no less; bench_collision), a
-// third of a posture call (perf, session 11). This one works in the first
+// third of a posture call (perf). This one works in the first
 // shape's frame with support functions that are a few sign tests.
 //
 // It answers separated cores only: when they overlap (penetration deeper

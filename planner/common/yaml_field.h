@@ -1,6 +1,6 @@
 #pragma once
 // A YAML node that knows which file and field it came from, so that every
-// error about it names both (DESIGN.md section 5).
+// error about it names both (docs/design.md section 5).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// The rough-trajectory author (issue 7): the paper's guide was written by
+// The rough-trajectory author: the paper's guide was written by
 // hand; here OMPL writes it. From the scenario's start configuration to a
 // posture in the goal region made by the posture generator (standing there;
 // or the start stance carried there; for a goal on the height of a link, the

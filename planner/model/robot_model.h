@@ -4,7 +4,7 @@
 // self-collision pairs, named postures). Immutable once loaded, so one model
 // is shared by every thread; per-thread evaluation lives in Kinematics.
 //
-// Simbody is hidden behind this header (DESIGN.md section 4: code including
+// Simbody is hidden behind this header (docs/design.md section 4: code including
 // Simbody headers must be built with -UNDEBUG).
 #include <map>
 #include <memory>

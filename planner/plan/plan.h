@@ -1,5 +1,5 @@
 #pragma once
-// A contact plan and its file format, acyclic.plan/1 (JSON, DESIGN.md section 8).
+// A contact plan and its file format, acyclic.plan/1 (JSON, docs/design.md section 8).
 #include <string>
 #include <vector>
 
@@ -51,7 +51,7 @@ struct StanceDiff {
 };
 StanceDiff diffStances(const std::vector<ContactSpec>& a, const std::vector<ContactSpec>& b);
 
-// What changes between two consecutive stances (DESIGN.md section 8): exactly
+// What changes between two consecutive stances (docs/design.md section 8): exactly
 // one contact added, one removed, or one contact's supporting flag flipped.
 // Returns an empty string when the step is one of those, otherwise why not.
 std::string checkStep(const PlanStance& a, const PlanStance& b, const Scenario& sc);

@@ -1,6 +1,6 @@
 #pragma once
 // A time-parameterized whole-body trajectory and its file format,
-// acyclic.trajectory/1 (JSON; README "Trajectory"). Written by the
+// acyclic.trajectory/1 (JSON; docs/design.md section 8). Written by the
 // interpolator, read by acyclic-check, the HRP-2 bridge and the exporter.
 //
 // Samples are equally spaced by dt from t = 0. The contacts are constant over

@@ -1,5 +1,5 @@
 #pragma once
-// Costs of the posture generator, behind one interface (DESIGN.md section 6):
+// Costs of the posture generator, behind one interface (docs/design.md section 6):
 // distance to a reference posture now, the guide potential f_T later.
 #include <vector>
 

@@ -1,5 +1,5 @@
 #pragma once
-// The posture generator (DESIGN.md section 6): one Ipopt solve per call finds
+// The posture generator (docs/design.md section 6): one Ipopt solve per call finds
 // a configuration (and the floating contact's placement, and the contact
 // forces) that satisfies a stance's constraints at the least cost.
 // Failures return a status with a reason; exceptions are for misuse only.
@@ -21,7 +21,7 @@ struct PostureGeneratorOptions {
   // Give up, as infeasible, when Ipopt enters its restoration phase: it
   // found no step that lowers the constraint violation enough from where it
   // is. For a search, where a quick "no" is worth more than a rare late
-  // "yes": in the chair's planning (session 10) 1,739 of 2,145 failed calls
+  // "yes": in the chair's planning 1,739 of 2,145 failed calls
   // went through it, 8 of 787 successes did, and the failures spent 47% of
   // their iterations after entering it. Off by default (the generator's
   // callers that need an answer whenever one exists); the planner sets it.
@@ -34,13 +34,13 @@ struct PostureGeneratorOptions {
   // it once per iteration (Ipopt's limited_memory_aug_solver=extended: rows
   // for the update's vectors, with -1 and +1 diagonals), instead of
   // Sherman-Morrison's dozen solves per iteration around it. With "ldl" the
-  // rows join the dense trailing block (kkt_ldl.h); bench_posture (session
-  // 9): solves per call a third, an iteration about 15% cheaper. With
+  // rows join the dense trailing block (kkt_ldl.h); bench_posture: solves
+  // per call a third, an iteration about 15% cheaper. With
   // "mumps" each call has a fixed cost that these small systems do not
-  // amortize: 1.2-1.8 times faster (session 7). The witnesses differ from
+  // amortize: 1.2-1.8 times faster. The witnesses differ from
   // Sherman-Morrison's, and searches are chaotic in them: the planner keeps
-  // Sherman-Morrison by default (PlannerParameters; README "Posture
-  // generator"), the interpolator uses the rows.
+  // Sherman-Morrison by default (PlannerParameters; docs/design.md,
+  // "Posture generator"), the interpolator uses the rows.
   bool lbfgs_in_kkt = true;
   // Ipopt's linear solver: "ldl" (kkt_ldl.h: a sparse LDL^T in an order
   // these KKT systems need no pivoting in, reentrant, so that two generators
@@ -52,15 +52,15 @@ struct PostureGeneratorOptions {
   // How Ipopt's adaptive barrier parameter is chosen at each iteration
   // (Ipopt's mu_oracle): "quality-function" (Ipopt's default) or "probing"
   // (Mehrotra's affine-scaling probe: one more back-solve per iteration,
-  // cheap with "ldl"), or "loqo". README "Figures" (session 11) has the
-  // measurements behind the default.
+  // cheap with "ldl"), or "loqo". The default: probing and loqo make
+  // fewer successes, and other witnesses for the planner's search.
   std::string mu_oracle = "quality-function";
   // Pair distances: DistanceEngine::Convex (convex_distance.h: GJK on the
-  // primitives' cores, several times faster than FCL's, session 11) or
+  // primitives' cores, several times faster than FCL's) or
   // DistanceEngine::Fcl (FCL's GJK, as the independent checks). The planner
   // keeps Fcl (PlannerParameters): its searches are chaotic in the
   // witnesses, and the chair's plan with Convex has a step the interpolator
-  // cannot make (README "The chair scenario: solved").
+  // cannot make (docs/design.md section 7).
   DistanceEngine distance_engine = DistanceEngine::Convex;
   int print_level = 0;                // Ipopt's, for debugging
   // Further Ipopt options "name=value", applied last (for tuning and debugging).

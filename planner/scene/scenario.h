@@ -1,7 +1,7 @@
 #pragma once
 // A planning problem: robot, scene, start configuration and stance, allowed
 // contacts, goal condition, optional hand-written key postures, seed.
-// Format acyclic.scenario/1, documented in README.md.
+// Format acyclic.scenario/1, documented in docs/design.md section 5.
 #include <cstdint>
 #include <limits>
 #include <memory>

@@ -1,6 +1,6 @@
 #pragma once
 // The environment: obstacles (for collision) and contact surfaces (for
-// contacts). Format acyclic.scene/1, documented in README.md.
+// contacts). Format acyclic.scene/1, documented in docs/design.md section 5.
 #include <memory>
 #include <string>
 #include <vector>

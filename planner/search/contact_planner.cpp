@@ -46,7 +46,7 @@ PlannerParameters::PlannerParameters() {
   // FCL's distances, not the generator's faster default (Convex): with
   // them the chair's search (618 nodes instead of 407) made a plan with a
   // foot step, wedged between a chair leg and the other foot, that the
-  // interpolator cannot make (session 11). A scenario may choose
+  // interpolator cannot make. A scenario may choose
   // (posture_distance_engine).
   posture.distance_engine = DistanceEngine::Fcl;
 }
@@ -697,7 +697,7 @@ struct ContactPlanner::Impl {
   // The plan along the path to `last`: each node's transition stance, with a
   // stance between two of them where the earlier change settles (an added
   // contact starts to support, a removed one is gone), so that consecutive
-  // stances differ by one contact (DESIGN.md section 8).
+  // stances differ by one contact (docs/design.md section 8).
   // Returns false, and marks the node where it fails dead, when a settled
   // stance gets no valid witness.
   bool exportPlan(int last, Plan& plan) {

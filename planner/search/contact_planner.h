@@ -36,10 +36,10 @@ struct PlannerParameters {
   // the search must cross a rise of f_T (a side step raises it while the
   // weight goes onto the trailing foot), a foot's pair otherwise supplies
   // placements without end, each a little worse than the last, and best
-  // first expands all of them below the rise (README "Contact planner").
+  // first expands all of them below the rise (docs/design.md section 7).
   double alternative_step = 0.02;
   // Subtracted around each candidate: a contact this close to one already
-  // tried is not a new one (20 cm by 20 cm, 40 degrees; see README "The chair scenario: solved").
+  // tried is not a new one (20 cm by 20 cm, 40 degrees; see docs/design.md section 7).
   BoxHalfSizes box{0.10, 0.10, 0.35};
   double duplicate_distance = 0.05;    // m: sons this close to a node (same contacts) are dropped
   double duplicate_angle = 0.35;       // rad

@@ -1,5 +1,5 @@
 #pragma once
-// The figures people look at (issue 9): joint angles and velocities over a
+// The figures people look at: joint angles and velocities over a
 // trajectory with their limits, the stability margin along it (the
 // independent quasi-static check), and the planner's progress over time.
 #include <vector>
