@@ -39,37 +39,6 @@ namespace {
 using namespace acyclic;
 const char* kName = "acyclic-hrp2-bridge";
 
-hrp2_command_t toMessage(const hrp2::Command& c) {
-  hrp2_command_t m;
-  m.utime = proc::nowMicros();
-  m.request_id = c.request_id;
-  m.sequence = c.sequence;
-  m.mode = static_cast<int8_t>(c.mode);
-  m.num_joints = static_cast<int32_t>(c.q.size());
-  m.q.assign(c.q.data(), c.q.data() + c.q.size());
-  m.dq.assign(c.dq.data(), c.dq.data() + c.dq.size());
-  for (int i = 0; i < 3; ++i) {
-    m.waist_position[i] = c.waist_position[i];
-    m.waist_rpy[i] = c.waist_rpy[i];
-    m.zmp_waist[i] = c.zmp_waist[i];
-  }
-  m.stabilizer = c.stabilizer;
-  return m;
-}
-
-hrp2_bridge_status_t toMessage(const hrp2::BridgeStatus& s) {
-  hrp2_bridge_status_t m;
-  m.utime = proc::nowMicros();
-  m.request_id = s.request_id;
-  m.state = static_cast<int8_t>(s.state);
-  m.reason = s.reason;
-  m.progress = s.progress;
-  m.commands_sent = s.commands_sent;
-  m.tracking_error_max = s.tracking_error_max;
-  m.safety_events = s.safety_events;
-  return m;
-}
-
 template <class F>
 struct Handler {
   F f;
@@ -212,13 +181,8 @@ int main(int argc, char** argv) {
     const std::int64_t now = hrp2::monotonicMicros();
     hrp2_state_t m;
     if (!proc::decode(rb, channels::kHrp2State, m, status)) return;
-    hrp2::MeasuredState s;
     // A wrong joint count is passed on as it is: the bridge refuses it (fault while streaming).
-    s.q = Eigen::Map<const Eigen::VectorXd>(m.q.data(), static_cast<Eigen::Index>(m.q.size()));
-    s.dq = Eigen::Map<const Eigen::VectorXd>(m.dq.data(), static_cast<Eigen::Index>(m.dq.size()));
-    s.request_id = m.request_id;
-    s.command_sequence = m.command_sequence;
-    s.servo_on = m.servo_on;
+    const hrp2::MeasuredState s = convert::fromMessage(m);
     std::lock_guard<std::mutex> lock(mutex);
     bridge.onState(s, now);
     got_state = true;
@@ -323,7 +287,7 @@ int main(int argc, char** argv) {
       events = bridge.takeEvents();
       st = bridge.status(now);
     }
-    if (cmd) bus->publish(channels::kHrp2Command, toMessage(*cmd));
+    if (cmd) bus->publish(channels::kHrp2Command, convert::toMessage(*cmd, proc::nowMicros()));
     for (const hrp2::BridgeEvent& e : events) {
       // Safety events and refusals: ACYCLIC_STATUS errors (and a log line); the rest: the log.
       if (e.safety || e.refused) status.error(e.request_id >= 0 ? e.request_id : st.request_id, e.text);
@@ -334,7 +298,7 @@ int main(int argc, char** argv) {
       }
     }
     if (st.state != last_state || now - last_status >= cfg.status_period * 1e6) {
-      bus->publish(channels::kHrp2BridgeStatus, toMessage(st));
+      bus->publish(channels::kHrp2BridgeStatus, convert::toMessage(st, proc::nowMicros()));
       last_status = now;
       if (st.state != last_state) {
         if (st.state == hrp2::BridgeState::Streaming || st.state == hrp2::BridgeState::Checking) status.busy(st.request_id);
@@ -361,7 +325,7 @@ int main(int argc, char** argv) {
   intake_thread.join();
   for (auto& c : checks) c.first.join();
   const hrp2::BridgeStatus st = bridge.status(hrp2::monotonicMicros());
-  bus->publish(channels::kHrp2BridgeStatus, toMessage(st));
+  bus->publish(channels::kHrp2BridgeStatus, convert::toMessage(st, proc::nowMicros()));
   status.stopping();
   char summary[300];
   std::snprintf(summary, sizeof summary,

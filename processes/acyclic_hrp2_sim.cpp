@@ -23,32 +23,12 @@
 #include "hrp2_bridge/sim/dynamics_simulation.h"
 #include "hrp2_bridge/sim/simulated_controller.h"
 #include "hrp2_bridge/trajectory_file.h"
+#include "processes/lcm_convert.h"
 #include "processes/lcm_process.h"
 
 namespace {
 
 const char* kName = "acyclic-hrp2-sim";
-
-acyclic::hrp2_state_t toMessage(const acyclic::hrp2::SimState& s) {
-  acyclic::hrp2_state_t m;
-  m.utime = acyclic::proc::nowMicros();
-  m.request_id = s.request_id;
-  m.command_sequence = s.command_sequence;
-  m.num_joints = static_cast<int32_t>(s.q.size());
-  m.q.assign(s.q.data(), s.q.data() + s.q.size());
-  m.dq.assign(s.dq.data(), s.dq.data() + s.dq.size());
-  for (int i = 0; i < 3; ++i) m.base_position[i] = s.configuration.base_position[i];
-  const Eigen::Quaterniond& o = s.configuration.base_orientation;
-  m.base_orientation[0] = o.w(), m.base_orientation[1] = o.x(), m.base_orientation[2] = o.y(), m.base_orientation[3] = o.z();
-  m.num_wrenches = static_cast<int32_t>(s.wrenches.size());
-  for (const auto& w : s.wrenches) {
-    m.wrench_names.push_back(w.name);
-    m.wrenches.emplace_back(w.wrench.data(), w.wrench.data() + 6);
-  }
-  m.servo_on = s.servo_on;
-  m.stabilizer = s.stabilizer;
-  return m;
-}
 
 }  // namespace
 
@@ -134,7 +114,7 @@ int main(int argc, char** argv) {
   }
   proc::StatusReporter status(*bus, kName);
   std::mutex mutex;
-  long bad_messages = 0;
+  long bad_messages = 0, bad_modes = 0;
   const int n = static_cast<int>(sim->state().q.size());
   // The robot's state: the kinematic controller's, or the dynamics' driven by it.
   auto robotState = [&] {
@@ -161,12 +141,14 @@ int main(int argc, char** argv) {
       return;
     }
     hrp2::SimCommand c;
-    c.request_id = m.request_id, c.sequence = m.sequence, c.mode = m.mode;
-    c.q = Eigen::Map<const Eigen::VectorXd>(m.q.data(), n);
-    c.dq = Eigen::Map<const Eigen::VectorXd>(m.dq.data(), n);
-    c.waist_position = Eigen::Vector3d(m.waist_position);
-    c.waist_rpy = Eigen::Vector3d(m.waist_rpy);
-    c.stabilizer = m.stabilizer;
+    try {
+      c = convert::fromMessage(m);
+    } catch (const std::exception& e) {
+      // An unknown mode: refused and counted, as a real controller would.
+      if (bad_modes++ == 0)
+        status.error(-1, std::string(channels::kHrp2Command) + ": " + e.what() + ": ignored (counted from now on)");
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex);
     sim->receive(c, now);
   }};
@@ -231,7 +213,7 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> wlock(wrench_mutex);
         st.wrenches = wrenches;
         st.equilibrium = equilibrium;
-        msg = toMessage(st);
+        msg = convert::toMessage(st, proc::nowMicros());
       }
       else if (!announced_freeze) {
         announced_freeze = true;
@@ -267,6 +249,7 @@ int main(int argc, char** argv) {
   proc::log(kName, "commands: " + std::to_string(sim->received()) + " received, " + std::to_string(sim->applied()) +
                        " applied, " + std::to_string(sim->dropped()) + " dropped, " + std::to_string(sim->rejected()) +
                        " rejected, " + std::to_string(bad_messages) + " of the wrong size, " +
+                       std::to_string(bad_modes) + " with an unknown mode, " +
                        std::to_string(status.undecodableCount()) + " not decoded, " +
                        std::to_string(sim->refusedPosition()) + " beyond position limits, " +
                        std::to_string(sim->refusedVelocity()) + " beyond velocity limits, " +
