@@ -294,6 +294,7 @@ hrp2_bridge_status_t toMessage(const hrp2::BridgeStatus& s, int64_t utime) {
   m.commands_sent = s.commands_sent;
   m.tracking_error_max = s.tracking_error_max;
   m.safety_events = s.safety_events;
+  m.finished_request_id = s.finished_request_id;
   return m;
 }
 

@@ -195,12 +195,13 @@ TEST(LcmConvert, Hrp2MessagesThereAndBack) {
   EXPECT_EQ(ms.command_sequence, 11);
   EXPECT_FALSE(ms.servo_on);
 
-  // The bridge's status.
+  // The bridge's status, with the request it finished.
   hrp2::BridgeStatus st;
   st.request_id = 7, st.state = hrp2::BridgeState::Idle, st.reason = "done", st.progress = 1;
-  st.commands_sent = 300, st.tracking_error_max = 0.01, st.safety_events = 2;
+  st.commands_sent = 300, st.tracking_error_max = 0.01, st.safety_events = 2, st.finished_request_id = 7;
   const hrp2_bridge_status_t bm = wire(convert::toMessage(st, 8));
   EXPECT_EQ(bm.state, +hrp2_bridge_status_t::IDLE);
+  EXPECT_EQ(bm.finished_request_id, 7);
   EXPECT_EQ(bm.commands_sent, 300);
   EXPECT_EQ(bm.safety_events, 2);
   EXPECT_EQ(bm.reason, "done");
