@@ -22,6 +22,8 @@
 #include "interpolator/interpolator.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/check/trajectory_check.h"
+#include "planner/common/format_error.h"
+#include "planner/plan/scenario_reference.h"
 #include "planner/search/planner_parameters.h"
 
 using namespace acyclic;
@@ -59,12 +61,13 @@ int main(int argc, char** argv) {
     plan_path = "(planned: " + sc.path + ")";
   } else {
     if (scenario_path.empty()) {
-      std::ifstream in(plan_path);
-      const std::string s = nlohmann::json::parse(in).at("scenario").get<std::string>();
-      const std::string beside = (std::filesystem::path(plan_path).parent_path() / s).string();
-      scenario_path = std::filesystem::exists(beside) ? beside
-                      : std::filesystem::exists(s)    ? s
-                                                      : std::string(ACYCLIC_SOURCE_DIR "/") + s;
+      try {
+        scenario_path = scenarioNamedBy(plan_path);
+      } catch (const FormatError&) {
+        // The bench also runs from its build folder: the source tree last.
+        std::ifstream in(plan_path);
+        scenario_path = std::string(ACYCLIC_SOURCE_DIR "/") + nlohmann::json::parse(in).at("scenario").get<std::string>();
+      }
     }
     sc = Scenario::load(scenario_path);
     plan = readPlan(plan_path, sc);

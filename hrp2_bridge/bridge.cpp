@@ -267,6 +267,7 @@ Command Bridge::streamCommand(std::int64_t now) {
   if (first_stream_seq_ < 0) first_stream_seq_ = sent.sequence;
   if (last) {
     active_ = false;
+    finished_request_id_ = request_id_;
     enter(BridgeState::Idle, now,
           "done: request " + std::to_string(request_id_) +
               fmt(" played (%.3f s), worst tracking error %.4f rad", d, tracking_error_max_),
@@ -336,6 +337,7 @@ BridgeStatus Bridge::status(std::int64_t now) const {
   st.tracking_error_last = tracking_error_last_;
   st.safety_events = safety_events_;
   st.state_fresh = stateFresh(now);
+  st.finished_request_id = finished_request_id_;
   return st;
 }
 

@@ -62,6 +62,7 @@ struct BridgeStatus {
   double tracking_error_last = 0;    // rad, at the last state
   std::int64_t safety_events = 0;
   bool state_fresh = false;
+  std::int64_t finished_request_id = -1;  // the last trajectory played to the end, -1 none
 };
 
 // Something the process should log (and count, when `safety`).
@@ -139,6 +140,7 @@ class Bridge {
   // Trajectory and playback.
   PreparedTrajectory traj_;
   std::int64_t request_id_ = -1, checking_id_ = -1;
+  std::int64_t finished_request_id_ = -1;
   BridgeState before_check_ = BridgeState::Idle;
   double tau_ = 0;                        // s of trajectory played
   double pos_ = 0;                        // the same in samples

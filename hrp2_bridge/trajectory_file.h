@@ -1,7 +1,7 @@
 #pragma once
 // A trajectory file with the scenario it was planned in: the scenario given,
-// or else the one the file names (its `scenario` field: as written, or
-// relative to the trajectory's folder). FormatError naming the file and field
+// or else the one the file names (its `scenario` field, resolved by
+// planner/plan/scenario_reference.h). FormatError naming the file and field
 // on bad input.
 #include <string>
 

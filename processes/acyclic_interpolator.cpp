@@ -5,18 +5,16 @@
 //   cannot be repaired, or cancelled by SIGINT/SIGTERM), 2 bad input (a file,
 //   a field, an option, or a plan whose witnesses or sequence are not valid).
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <unistd.h>
 
 #include "processes/command_line.h"
 #include "interpolator/interpolator.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/common/format_error.h"
+#include "planner/plan/scenario_reference.h"
 #include "processes/lcm_process.h"
 #include "processes/interpolator_service.h"
 
@@ -24,27 +22,6 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 extern "C" void onSignal(int) { g_stop = true; }
-
-// The plan's "scenario" field, resolved against the plan's folder, then the current directory.
-std::string scenarioOfPlan(const std::string& plan_path) {
-  std::ifstream in(plan_path);
-  if (!in) throw acyclic::FormatError(plan_path, "", "cannot read the file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw acyclic::FormatError(plan_path, "", std::string("not JSON: ") + e.what());
-  }
-  if (!j.is_object() || !j.contains("scenario") || !j["scenario"].is_string())
-    throw acyclic::FormatError(plan_path, "scenario", "expected the scenario file's path (a string)");
-  const std::filesystem::path s = j["scenario"].get<std::string>();
-  if (s.is_absolute()) return s.string();
-  const std::filesystem::path beside = std::filesystem::path(plan_path).parent_path() / s;
-  if (std::filesystem::exists(beside)) return beside.string();
-  if (std::filesystem::exists(s)) return s.string();
-  throw acyclic::FormatError(plan_path, "scenario", "'" + s.string() +
-                             "' found neither beside the plan nor in the current directory (give --scenario)");
-}
 
 }  // namespace
 
@@ -108,7 +85,7 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   try {
-    if (scenario_path.empty()) scenario_path = scenarioOfPlan(in);
+    if (scenario_path.empty()) scenario_path = acyclic::scenarioNamedBy(in);
     const acyclic::Scenario sc = acyclic::Scenario::load(scenario_path);
     const acyclic::Plan plan = acyclic::readPlan(in, sc);
     const bool tty = !quiet && isatty(STDERR_FILENO);

@@ -18,6 +18,7 @@
 
 #include "processes/command_line.h"
 #include "acyclic/hrp2_bridge_status_t.hpp"
+#include "processes/bridge_outcome.h"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/process_status_t.hpp"
 #include "acyclic/progress_t.hpp"
@@ -296,12 +297,9 @@ int main(int argc, char** argv) {
       }
       if (trajectory_written && execute && ear.played) {
         const hrp2_bridge_status_t& b = *ear.played;
-        const bool finished = b.reason.rfind("done: request " + std::to_string(request_id) + " ", 0) == 0;
-        // Holding (a watchdog fired), a fault, an e-stop or a refusal ends the demo run: the bridge
-        // keeps the robot safe and waits for an operator, which a launcher is not.
-        const bool broken = b.state == hrp2_bridge_status_t::FAULT || b.state == hrp2_bridge_status_t::STOPPED ||
-                            b.state == hrp2_bridge_status_t::HOLDING || b.reason.rfind("refused", 0) == 0;
-        if (finished || broken) {
+        const proc::BridgeOutcome outcome = proc::bridgeOutcome(b, request_id);
+        const bool finished = outcome == proc::BridgeOutcome::Finished;
+        if (outcome != proc::BridgeOutcome::Going) {
           if (ear.tty) std::fprintf(stderr, "\n");
           say(std::string("execution ") + (finished ? "done" : "FAILED") + ": " + b.reason + "; " +
               std::to_string(b.commands_sent) + " commands, worst tracking error " +

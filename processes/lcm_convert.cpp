@@ -221,4 +221,125 @@ Trajectory fromMessage(const trajectory_t& m, const Scenario& sc) {
   return tr;
 }
 
+int8_t toMessage(hrp2::BridgeState s) {
+  switch (s) {
+    case hrp2::BridgeState::Idle: return hrp2_bridge_status_t::IDLE;
+    case hrp2::BridgeState::Checking: return hrp2_bridge_status_t::CHECKING;
+    case hrp2::BridgeState::Streaming: return hrp2_bridge_status_t::STREAMING;
+    case hrp2::BridgeState::Holding: return hrp2_bridge_status_t::HOLDING;
+    case hrp2::BridgeState::Stopped: return hrp2_bridge_status_t::STOPPED;
+    case hrp2::BridgeState::Fault: return hrp2_bridge_status_t::FAULT;
+  }
+  // Only a value outside the enum gets here: the worst state, not a guess.
+  return hrp2_bridge_status_t::FAULT;
+}
+
+hrp2::BridgeState bridgeStateFromMessage(int8_t state) {
+  switch (state) {
+    case hrp2_bridge_status_t::IDLE: return hrp2::BridgeState::Idle;
+    case hrp2_bridge_status_t::CHECKING: return hrp2::BridgeState::Checking;
+    case hrp2_bridge_status_t::STREAMING: return hrp2::BridgeState::Streaming;
+    case hrp2_bridge_status_t::HOLDING: return hrp2::BridgeState::Holding;
+    case hrp2_bridge_status_t::STOPPED: return hrp2::BridgeState::Stopped;
+    case hrp2_bridge_status_t::FAULT: return hrp2::BridgeState::Fault;
+  }
+  throw FormatError("hrp2_bridge_status_t", "state", "IDLE, CHECKING, STREAMING, HOLDING, STOPPED or FAULT (got " +
+                                                         std::to_string(state) + ")");
+}
+
+int8_t toMessage(hrp2::CommandMode mode) {
+  switch (mode) {
+    case hrp2::CommandMode::Stream: return hrp2_command_t::STREAM;
+    case hrp2::CommandMode::Hold: return hrp2_command_t::HOLD;
+    case hrp2::CommandMode::Freeze: return hrp2_command_t::FREEZE;
+  }
+  // Only a value outside the enum gets here: the safest command, not a guess.
+  return hrp2_command_t::FREEZE;
+}
+
+hrp2::CommandMode commandModeFromMessage(int8_t mode) {
+  switch (mode) {
+    case hrp2_command_t::STREAM: return hrp2::CommandMode::Stream;
+    case hrp2_command_t::HOLD: return hrp2::CommandMode::Hold;
+    case hrp2_command_t::FREEZE: return hrp2::CommandMode::Freeze;
+  }
+  throw FormatError("hrp2_command_t", "mode", "STREAM, HOLD or FREEZE (got " + std::to_string(mode) + ")");
+}
+
+hrp2_command_t toMessage(const hrp2::Command& c, int64_t utime) {
+  hrp2_command_t m{};
+  m.utime = utime;
+  m.request_id = c.request_id;
+  m.sequence = c.sequence;
+  m.mode = toMessage(c.mode);
+  m.num_joints = static_cast<int32_t>(c.q.size());
+  m.q.assign(c.q.data(), c.q.data() + c.q.size());
+  m.dq.assign(c.dq.data(), c.dq.data() + c.dq.size());
+  for (int i = 0; i < 3; ++i) {
+    m.waist_position[i] = c.waist_position[i];
+    m.waist_rpy[i] = c.waist_rpy[i];
+    m.zmp_waist[i] = c.zmp_waist[i];
+  }
+  m.stabilizer = c.stabilizer;
+  return m;
+}
+
+hrp2_bridge_status_t toMessage(const hrp2::BridgeStatus& s, int64_t utime) {
+  hrp2_bridge_status_t m{};
+  m.utime = utime;
+  m.request_id = s.request_id;
+  m.state = toMessage(s.state);
+  m.reason = s.reason;
+  m.progress = s.progress;
+  m.commands_sent = s.commands_sent;
+  m.tracking_error_max = s.tracking_error_max;
+  m.safety_events = s.safety_events;
+  m.finished_request_id = s.finished_request_id;
+  return m;
+}
+
+hrp2_state_t toMessage(const hrp2::SimState& s, int64_t utime) {
+  hrp2_state_t m{};
+  m.utime = utime;
+  m.request_id = s.request_id;
+  m.command_sequence = s.command_sequence;
+  m.num_joints = static_cast<int32_t>(s.q.size());
+  m.q.assign(s.q.data(), s.q.data() + s.q.size());
+  m.dq.assign(s.dq.data(), s.dq.data() + s.dq.size());
+  for (int i = 0; i < 3; ++i) m.base_position[i] = s.configuration.base_position[i];
+  const Eigen::Quaterniond& o = s.configuration.base_orientation;
+  m.base_orientation[0] = o.w(), m.base_orientation[1] = o.x(), m.base_orientation[2] = o.y(),
+  m.base_orientation[3] = o.z();
+  m.num_wrenches = static_cast<int32_t>(s.wrenches.size());
+  for (const auto& w : s.wrenches) {
+    m.wrench_names.push_back(w.name);
+    m.wrenches.emplace_back(w.wrench.data(), w.wrench.data() + 6);
+  }
+  m.servo_on = s.servo_on;
+  m.stabilizer = s.stabilizer;
+  return m;
+}
+
+hrp2::MeasuredState fromMessage(const hrp2_state_t& m) {
+  hrp2::MeasuredState s;
+  s.q = Eigen::Map<const Eigen::VectorXd>(m.q.data(), static_cast<Eigen::Index>(m.q.size()));
+  s.dq = Eigen::Map<const Eigen::VectorXd>(m.dq.data(), static_cast<Eigen::Index>(m.dq.size()));
+  s.request_id = m.request_id;
+  s.command_sequence = m.command_sequence;
+  s.servo_on = m.servo_on;
+  return s;
+}
+
+hrp2::SimCommand fromMessage(const hrp2_command_t& m) {
+  hrp2::SimCommand c;
+  commandModeFromMessage(m.mode);  // refuses an unknown mode; the controller keeps the message's value
+  c.request_id = m.request_id, c.sequence = m.sequence, c.mode = m.mode;
+  c.q = Eigen::Map<const Eigen::VectorXd>(m.q.data(), static_cast<Eigen::Index>(m.q.size()));
+  c.dq = Eigen::Map<const Eigen::VectorXd>(m.dq.data(), static_cast<Eigen::Index>(m.dq.size()));
+  c.waist_position = Eigen::Vector3d(m.waist_position);
+  c.waist_rpy = Eigen::Vector3d(m.waist_rpy);
+  c.stabilizer = m.stabilizer;
+  return c;
+}
+
 }  // namespace acyclic::convert

@@ -590,6 +590,7 @@ TEST_F(Hrp2Processes, FuzzOnEveryChannelLeavesBridgeAndSimulatorUpAndAGoodTrajec
   ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::STREAMING); }, 10)) << logs();
   ASSERT_TRUE(serveUntil([&] { return bridgeIn(hrp2_bridge_status_t::IDLE); }, 10)) << logs();
   EXPECT_EQ(heard_.statuses.back().reason.rfind("done: request 5 ", 0), 0u) << heard_.statuses.back().reason;
+  EXPECT_EQ(heard_.statuses.back().finished_request_id, 5);  // what acyclic-launch waits for
   EXPECT_EQ(stop(b), 0) << logs();
   EXPECT_EQ(stop(s), 0);
 }

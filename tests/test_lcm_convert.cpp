@@ -110,3 +110,99 @@ TEST(LcmConvert, TrajectoryRoundTrip) {
   bad.joints[1][4] = std::nan("");
   EXPECT_THROW(convert::fromMessage(bad, sc), FormatError);
 }
+
+// HRP-2's enums, value by value: every value there and back, and a value the
+// other side does not know refused (message to enum) or mapped to the safest
+// value (enum to message), never cast.
+TEST(LcmConvert, BridgeStateEveryValueRoundTrips) {
+  using S = hrp2::BridgeState;
+  const std::vector<std::pair<S, int8_t>> pairs = {
+      {S::Idle, +hrp2_bridge_status_t::IDLE},         {S::Checking, +hrp2_bridge_status_t::CHECKING},
+      {S::Streaming, +hrp2_bridge_status_t::STREAMING}, {S::Holding, +hrp2_bridge_status_t::HOLDING},
+      {S::Stopped, +hrp2_bridge_status_t::STOPPED},   {S::Fault, +hrp2_bridge_status_t::FAULT}};
+  for (const auto& [state, constant] : pairs) {
+    EXPECT_EQ(convert::toMessage(state), constant) << static_cast<int>(state);
+    EXPECT_EQ(convert::bridgeStateFromMessage(constant), state) << int(constant);
+  }
+  try {
+    convert::bridgeStateFromMessage(6);
+    FAIL() << "an unknown state was accepted";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.field(), "state");
+    EXPECT_NE(std::string(e.what()).find("got 6"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(convert::bridgeStateFromMessage(-1), FormatError);
+  EXPECT_EQ(convert::toMessage(static_cast<S>(42)), +hrp2_bridge_status_t::FAULT);
+}
+
+TEST(LcmConvert, CommandModeEveryValueRoundTrips) {
+  using M = hrp2::CommandMode;
+  const std::vector<std::pair<M, int8_t>> pairs = {
+      {M::Stream, +hrp2_command_t::STREAM}, {M::Hold, +hrp2_command_t::HOLD}, {M::Freeze, +hrp2_command_t::FREEZE}};
+  for (const auto& [mode, constant] : pairs) {
+    EXPECT_EQ(convert::toMessage(mode), constant);
+    EXPECT_EQ(convert::commandModeFromMessage(constant), mode);
+  }
+  try {
+    convert::commandModeFromMessage(3);
+    FAIL() << "an unknown mode was accepted";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.field(), "mode");
+  }
+  EXPECT_EQ(convert::toMessage(static_cast<M>(42)), +hrp2_command_t::FREEZE);
+}
+
+TEST(LcmConvert, Hrp2MessagesThereAndBack) {
+  // The bridge's command, as the simulated controller reads it.
+  hrp2::Command c;
+  c.request_id = 7, c.sequence = 12, c.mode = hrp2::CommandMode::Hold;
+  c.q = Eigen::VectorXd::LinSpaced(4, 0.1, 0.4);
+  c.dq = Eigen::VectorXd::Constant(4, -0.5);
+  c.waist_position = {1, 2, 3}, c.waist_rpy = {0.1, 0.2, 0.3}, c.zmp_waist = {4, 5, 6};
+  c.stabilizer = false;
+  const hrp2_command_t cm = wire(convert::toMessage(c, 99));
+  EXPECT_EQ(cm.utime, 99);
+  EXPECT_EQ(cm.mode, +hrp2_command_t::HOLD);
+  EXPECT_EQ(cm.zmp_waist[2], 6);
+  const hrp2::SimCommand sc = convert::fromMessage(cm);
+  EXPECT_EQ(sc.request_id, 7);
+  EXPECT_EQ(sc.sequence, 12);
+  EXPECT_EQ(sc.mode, +hrp2_command_t::HOLD);
+  EXPECT_EQ(sc.q, c.q);
+  EXPECT_EQ(sc.dq, c.dq);
+  EXPECT_EQ(sc.waist_position, c.waist_position);
+  EXPECT_EQ(sc.waist_rpy, c.waist_rpy);
+  EXPECT_FALSE(sc.stabilizer);
+  hrp2_command_t unknown = cm;
+  unknown.mode = 9;
+  EXPECT_THROW(convert::fromMessage(unknown), FormatError);
+
+  // The simulated controller's state, as the bridge reads it.
+  hrp2::SimState s;
+  s.request_id = 7, s.command_sequence = 11;
+  s.q = c.q, s.dq = c.dq;
+  s.configuration.base_position = {0.5, 0, 0.6};
+  s.wrenches.push_back({"RF", Eigen::Matrix<double, 6, 1>::Constant(2)});
+  s.servo_on = false;
+  const hrp2_state_t sm = wire(convert::toMessage(s, 5));
+  EXPECT_EQ(sm.num_wrenches, 1);
+  EXPECT_EQ(sm.wrench_names.at(0), "RF");
+  EXPECT_EQ(sm.base_position[2], 0.6);
+  const hrp2::MeasuredState ms = convert::fromMessage(sm);
+  EXPECT_EQ(ms.q, s.q);
+  EXPECT_EQ(ms.dq, s.dq);
+  EXPECT_EQ(ms.request_id, 7);
+  EXPECT_EQ(ms.command_sequence, 11);
+  EXPECT_FALSE(ms.servo_on);
+
+  // The bridge's status, with the request it finished.
+  hrp2::BridgeStatus st;
+  st.request_id = 7, st.state = hrp2::BridgeState::Idle, st.reason = "done", st.progress = 1;
+  st.commands_sent = 300, st.tracking_error_max = 0.01, st.safety_events = 2, st.finished_request_id = 7;
+  const hrp2_bridge_status_t bm = wire(convert::toMessage(st, 8));
+  EXPECT_EQ(bm.state, +hrp2_bridge_status_t::IDLE);
+  EXPECT_EQ(bm.finished_request_id, 7);
+  EXPECT_EQ(bm.commands_sent, 300);
+  EXPECT_EQ(bm.safety_events, 2);
+  EXPECT_EQ(bm.reason, "done");
+}
