@@ -1,5 +1,5 @@
 #pragma once
-// The HRP-2 bridge's state machine (README "HRP-2 bridge"), without LCM and
+// The HRP-2 bridge's state machine (docs/design.md section 11), without LCM and
 // without clocks: every input carries `now` (microseconds, one monotonic time
 // base), so tests drive it deterministically.
 //

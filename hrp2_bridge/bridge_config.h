@@ -1,5 +1,5 @@
 #pragma once
-// The bridge's parameters (README "HRP-2 bridge"): the controller period and
+// The bridge's parameters (docs/design.md section 11): the controller period and
 // every safety threshold, with defaults that fit HRP-2 No.14 (200 Hz).
 // Optionally read from a YAML file, format acyclic.hrp2_bridge/1; a wrong
 // field is a FormatError naming the file and the field.

@@ -1,5 +1,5 @@
 #pragma once
-// The validity contract of a trajectory (DESIGN.md section 9) before the
+// The validity contract of a trajectory (docs/design.md section 9) before the
 // bridge streams or exports it: every sample a valid posture with its phase's
 // contacts (the independent check, planner/check/trajectory_check.h), joint
 // velocities within limits, rest where a contact is made or broken. The

@@ -1,5 +1,5 @@
 #pragma once
-// The moving body's path between two stances (DESIGN.md section 10): straight
+// The moving body's path between two stances (docs/design.md section 10): straight
 // along the surface normal where it leaves a surface and where it reaches one,
 // a C1 cubic spline between (through raised via-points after a repair), the
 // orientation held on the straight parts (a sole stays flat near the floor)

@@ -1,5 +1,5 @@
 #pragma once
-// The moving body's path planned with OMPL (DESIGN.md section 10's
+// The moving body's path planned with OMPL (docs/design.md section 10's
 // "or plan the body's path with OMPL"): the repair for a body that must pass
 // through a narrow gap, where every raised or sideways spline either cuts an
 // obstacle or leaves the body's orientation to the posture generator, whose

@@ -1,5 +1,5 @@
 #pragma once
-// The trajectory interpolator (DESIGN.md section 10, paper 3.3 and 4): turns a
+// The trajectory interpolator (docs/design.md section 10, paper 3.3 and 4): turns a
 // contact plan into a time-parameterized whole-body trajectory at the
 // controller's rate. Stances are filtered (stance_filter.h), each transition
 // is turned into knots (transition.h), and the pieces of constant contacts are

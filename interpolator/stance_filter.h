@@ -1,5 +1,5 @@
 #pragma once
-// Stance filtering (the paper's open problem, DESIGN.md section 10): a stance
+// Stance filtering (the paper's open problem, docs/design.md section 10): a stance
 // is dropped when its neighbours hold the same contacts and the direct
 // transition between them, all contacts held, is valid (knots found, every
 // segment's middle valid). Typical drops: a contact touched and left again

@@ -1,5 +1,5 @@
 #pragma once
-// Time parameterization (DESIGN.md section 10): each piece of motion is a
+// Time parameterization (docs/design.md section 10): each piece of motion is a
 // polyline of configurations, travelled from rest to rest along the polyline
 // itself (the path the interpolator validated), as fast as these bounds allow:
 // - velocity: every joint within a share of its velocity limit, every link

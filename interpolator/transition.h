@@ -1,5 +1,5 @@
 #pragma once
-// One transition of a plan (DESIGN.md section 10): designed from the plan's
+// One transition of a plan (docs/design.md section 10): designed from the plan's
 // structure, then turned into knots (witness postures and posture-generator
 // solutions) grouped in pieces of constant contacts.
 //

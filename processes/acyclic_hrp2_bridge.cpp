@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
                  "scenario (robot and scene); required in LCM mode, default in file mode: the trajectory's own");
   app.add_option("--trajectory", o.trajectory_path, "file mode: stream this trajectory file (acyclic.trajectory/1)");
   app.add_option("--request-id", o.file_request_id, "file mode: the request id its commands carry (default 1)");
-  app.add_option("--config", o.config_path, "bridge configuration (acyclic.hrp2_bridge/1; README \"HRP-2 bridge\")");
+  app.add_option("--config", o.config_path, "bridge configuration (acyclic.hrp2_bridge/1; docs/design.md section 11)");
   app.add_option("--dt", o.dt, "controller period, s (default: the configuration's, else 0.005)");
   app.add_option("--wait-state", o.wait_state, "file mode: seconds to wait for the first HRP2_STATE (default 5)");
   app.add_option("--zmp-stride", o.zmp_stride, "quasi-static LP every N samples, interpolated between (default 10)")

@@ -1,4 +1,4 @@
-// Built with -UNDEBUG (includes Simbody; DESIGN.md section 4).
+// Built with -UNDEBUG (includes Simbody; docs/design.md section 4).
 #include "hrp2_bridge/sim/dynamics_simulation.h"
 
 #include <Simbody.h>

@@ -10,7 +10,7 @@
 // No LCM, no clock: the caller plays a whole trajectory (simulate()) or
 // streams references and advances time (DynamicsSimulator).
 //
-// Simbody is hidden behind this header (DESIGN.md section 4).
+// Simbody is hidden behind this header (docs/design.md section 4).
 #include <functional>
 #include <memory>
 #include <string>
