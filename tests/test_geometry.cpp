@@ -43,6 +43,25 @@ TEST(Geometry, PolygonSignedDistanceAndOrientation) {
   EXPECT_LT((sq.nearestBoundaryPoint({0.5, 0.9}) - Eigen::Vector2d(0.5, 1)).norm(), 1e-12);  // from inside
 }
 
+TEST(Geometry, PolygonInsetMovesEveryEdgeInward) {
+  const ConvexPolygon rect({{-0.077, -0.069}, {0.14, -0.069}, {0.14, 0.069}, {-0.077, 0.069}});
+  const ConvexPolygon a = rect.inset(0.02);
+  ASSERT_EQ(a.size(), 4u);
+  for (const auto& v : a.vertices()) EXPECT_NEAR(rect.signedDistance(v), -0.02, 1e-12);
+  EXPECT_NEAR(a.area(), (0.217 - 0.04) * (0.138 - 0.04), 1e-12);
+  // Capped at half the centroid's depth (0.069): half the width left.
+  const ConvexPolygon b = rect.inset(1.0);
+  EXPECT_NEAR(b.area(), (0.217 - 0.069) * (0.138 - 0.069), 1e-12);
+  EXPECT_EQ(rect.inset(0).vertices(), rect.vertices());
+  // A short edge between two sharp corners would vanish: scaled instead, every
+  // edge at least d inside.
+  const ConvexPolygon kite({{0, -1}, {4, -0.01}, {4, 0.01}, {0, 1}});
+  const ConvexPolygon k = kite.inset(0.3);
+  ASSERT_EQ(k.size(), 4u);
+  for (const auto& v : k.vertices()) EXPECT_LE(kite.signedDistance(v), -0.3 + 1e-12);
+  EXPECT_THROW(rect.inset(-0.01), std::invalid_argument);
+}
+
 TEST(Geometry, PolygonRejectsBadInput) {
   EXPECT_THROW(ConvexPolygon({{0, 0}, {1, 0}}), std::invalid_argument);
   EXPECT_THROW(ConvexPolygon({{0, 0}, {1, 0}, {2, 0}}), std::invalid_argument);                   // no area
