@@ -49,9 +49,9 @@ TEST(Geometry, PolygonInsetMovesEveryEdgeInward) {
   ASSERT_EQ(a.size(), 4u);
   for (const auto& v : a.vertices()) EXPECT_NEAR(rect.signedDistance(v), -0.02, 1e-12);
   EXPECT_NEAR(a.area(), (0.217 - 0.04) * (0.138 - 0.04), 1e-12);
-  // Capped at half the centroid's depth (0.069): half the width left.
+  // Capped at three quarters of the centroid's depth (0.069): a quarter of the width left.
   const ConvexPolygon b = rect.inset(1.0);
-  EXPECT_NEAR(b.area(), (0.217 - 0.069) * (0.138 - 0.069), 1e-12);
+  EXPECT_NEAR(b.area(), (0.217 - 0.1035) * (0.138 - 0.1035), 1e-12);
   EXPECT_EQ(rect.inset(0).vertices(), rect.vertices());
   // A short edge between two sharp corners would vanish: scaled instead, every
   // edge at least d inside.

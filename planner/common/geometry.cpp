@@ -91,7 +91,7 @@ ConvexPolygon ConvexPolygon::inset(double d) const {
   if (d == 0) return *this;
   const Eigen::Vector2d c = centroid();
   const double h = -signedDistance(c);  // the centroid's distance to the nearest edge (> 0: convex, positive area)
-  d = std::min(d, 0.5 * h);
+  d = std::min(d, 0.75 * h);
   const std::size_t n = v_.size();
   std::vector<Eigen::Vector2d> normal(n);  // outward unit normal of edge i (v_i to v_i+1)
   for (std::size_t i = 0; i < n; ++i) {

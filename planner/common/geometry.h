@@ -37,9 +37,9 @@ class ConvexPolygon {
   Eigen::Vector2d centroid() const;
   // The polygon shrunk by d >= 0: every edge moved inward by d along its
   // normal, so that its points are at least d inside every edge of this one.
-  // d is capped at half the centroid's distance to the nearest edge, so that
-  // a small polygon keeps a positive size (at least half its own about the
-  // centroid). Where moving the edges would make one vanish (a short edge
+  // d is capped at three quarters of the centroid's distance to the nearest
+  // edge, so that a small polygon keeps a positive size (at least a quarter
+  // of its own about the centroid). Where moving the edges would make one vanish (a short edge
   // between two sharp corners), the polygon is scaled about the centroid
   // instead, each edge moving inward by at least the capped d.
   ConvexPolygon inset(double d) const;

@@ -106,8 +106,8 @@ struct PostureOptions {
   // edge rolls the robot over it.
   // support_inset (m): the forces of each supporting contact applied at the
   // corners of its spot polygon shrunk by this much (ConvexPolygon::inset:
-  // every edge moved inward, capped at half the centroid's distance to the
-  // nearest edge), so that its centre of pressure stays this far inside the
+  // every edge moved inward, capped at three quarters of the centroid's
+  // distance to the nearest edge), so that its centre of pressure stays this far inside the
   // real edges. friction_share: the pyramid's edges at friction_share * mu
   // (in (0, 1]): tangential forces within that share of the friction.
   // Both only shrink the set of forces the generator may use (points inside
