@@ -42,6 +42,7 @@ struct InterpolatorOptions {
   // The knots' stability margins (PostureOptions::support_inset, m, and
   // friction_share): none by default.
   double support_inset = 0;
+  double support_inset_y = -1;  // >= 0: across the spot (its y) instead
   double friction_share = 1;
   // Each posture call bounded by iterations, not time: same input, same output.
   int posture_iterations = 100;

@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
                  "stability margin of the knots: each supporting contact's forces applied this far (m) inside "
                  "its spot's edges")
       ->capture_default_str();
+  app.add_option("--support-inset-y", o.support_inset_y,
+                 "the same along each spot's y axis (across a sole) instead, m (negative: --support-inset)")
+      ->capture_default_str();
   app.add_option("--friction-share", o.friction_share,
                  "stability margin of the knots: the share of each surface's friction coefficient used, in (0, 1]")
       ->capture_default_str();

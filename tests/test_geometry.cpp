@@ -60,6 +60,22 @@ TEST(Geometry, PolygonInsetMovesEveryEdgeInward) {
   ASSERT_EQ(k.size(), 4u);
   for (const auto& v : k.vertices()) EXPECT_LE(kite.signedDistance(v), -0.3 + 1e-12);
   EXPECT_THROW(rect.inset(-0.01), std::invalid_argument);
+  // Shrunk by a box: 1 cm along x, 4 cm along y.
+  const ConvexPolygon c = rect.inset(0.01, 0.04);
+  EXPECT_NEAR(c.area(), (0.217 - 0.02) * (0.138 - 0.08), 1e-12);
+  EXPECT_EQ(rect.inset(0.02, 0.02).vertices(), a.vertices());
+  // Capped: the y edges at three quarters of 0.069, x scaled alike.
+  const ConvexPolygon e = rect.inset(0.01, 0.1);
+  const double f = 0.75 * 0.069 / 0.1;
+  EXPECT_NEAR(e.area(), (0.217 - 0.02 * f) * (0.138 - 0.2 * f), 1e-12);
+  // A tilted edge moves by dx |n_x| + dy |n_y|.
+  const ConvexPolygon tri({{0, 0}, {2, 0}, {0, 2}});
+  const ConvexPolygon t = tri.inset(0.1, 0.2);
+  for (const auto& v : t.vertices()) {
+    EXPECT_GE(v.x(), 0.1 - 1e-12);
+    EXPECT_GE(v.y(), 0.2 - 1e-12);
+    EXPECT_LE(v.x() + v.y(), 2 - 0.3 + 1e-12);
+  }
 }
 
 TEST(Geometry, PolygonRejectsBadInput) {

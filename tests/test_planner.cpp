@@ -253,7 +253,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
                                              "posture_lbfgs_in_kkt: true, alternative_step: 0.05, "
                                              "posture_stop_at_restoration: false, posture_mu_oracle: probing, "
                                              "posture_distance_engine: convex, posture_pyramid_edges: 8, "
-                                             "posture_support_inset: 0.02, posture_friction_share: 0.8}\n"));
+                                             "posture_support_inset: 0.02, posture_friction_share: 0.8, "
+                                             "posture_support_inset_y: 0.03}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -278,6 +279,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_EQ(plannerParameters(plain).posture.problem.pyramid_sides, 4);  // the planner's default
   EXPECT_DOUBLE_EQ(p.posture.problem.support_inset, 0.02);
   EXPECT_DOUBLE_EQ(p.posture.problem.friction_share, 0.8);
+  EXPECT_DOUBLE_EQ(p.posture.problem.support_inset_y, 0.03);
+  EXPECT_LT(plannerParameters(plain).posture.problem.support_inset_y, 0.0);  // as support_inset
   EXPECT_EQ(plannerParameters(plain).posture.problem.support_inset, 0.0);  // no margins unless asked
   EXPECT_EQ(plannerParameters(plain).posture.problem.friction_share, 1.0);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
@@ -297,6 +300,7 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {posture_pyramid_edges: 6}\n", "planner.posture_pyramid_edges"},
            {"planner: {posture_support_inset: -0.01}\n", "planner.posture_support_inset"},
            {"planner: {posture_friction_share: 1.2}\n", "planner.posture_friction_share"},
+           {"planner: {posture_support_inset_y: -0.02}\n", "planner.posture_support_inset_y"},
            {"planner: {posture_friction_share: 0}\n", "planner.posture_friction_share"}}) {
     const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
     try {

@@ -102,6 +102,7 @@ Eigen::VectorXd numericCostGradient(PostureProblem& p, const Eigen::VectorXd& x)
 PostureOptions withMargins() {
   PostureOptions o;
   o.support_inset = 0.02;
+  o.support_inset_y = 0.03;
   o.friction_share = 0.8;
   return o;
 }

@@ -43,6 +43,12 @@ class ConvexPolygon {
   // between two sharp corners), the polygon is scaled about the centroid
   // instead, each edge moving inward by at least the capped d.
   ConvexPolygon inset(double d) const;
+  // Shrunk by a box: the points p such that p + [-dx, dx] x [-dy, dy] is
+  // inside (an edge of outward normal n moved inward by dx |n_x| + dy |n_y|);
+  // (dx, dy) scaled down where an edge would move more than three quarters
+  // of the centroid's distance to it, scaled about the centroid where one
+  // would vanish (as inset(d), which it equals for dx = dy = d).
+  ConvexPolygon inset(double dx, double dy) const;
 
  private:
   std::vector<Eigen::Vector2d> v_;

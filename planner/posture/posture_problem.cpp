@@ -48,6 +48,8 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
                                 std::to_string(kFrictionPyramidEdges) + " of at least 3");
   if (!(opt_.support_inset >= 0 && std::isfinite(opt_.support_inset)))
     throw std::invalid_argument("support_inset: expected a finite length >= 0 (m)");
+  if (!(opt_.support_inset_y < 0 || std::isfinite(opt_.support_inset_y)))
+    throw std::invalid_argument("support_inset_y: expected a finite length (m; < 0: support_inset)");
   if (!(opt_.friction_share > 0 && opt_.friction_share <= 1))
     throw std::invalid_argument("friction_share: expected a share in (0, 1]");
   if (req_.initial_guess.joints.size() != robot_->numJoints())
@@ -113,7 +115,8 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
     sup.contact = ci;
     sup.link = robot_->spots()[c.spot].link;
     const Eigen::Isometry3d T = contactFrame(s, c.placement);
-    const ConvexPolygon polygon = robot_->spots()[c.spot].polygon.inset(opt_.support_inset);
+    const ConvexPolygon polygon = robot_->spots()[c.spot].polygon.inset(
+        opt_.support_inset, opt_.support_inset_y >= 0 ? opt_.support_inset_y : opt_.support_inset);
     for (const auto& v : polygon.vertices()) sup.corners.push_back(T * Eigen::Vector3d(v.x(), v.y(), 0));
     const Eigen::Matrix3d R = s.frame.linear();
     const double mu = opt_.friction_share * s.friction;

@@ -114,6 +114,9 @@ struct PostureOptions {
   // the spot, edges inside the contract's pyramid): its witnesses still pass
   // the check, which is unchanged.
   double support_inset = 0;
+  // support_inset_y >= 0: the inset along the spot's y axis instead (across a
+  // sole; along it, x, support_inset): the spot eroded by a box (ConvexPolygon::inset(dx, dy)).
+  double support_inset_y = -1;
   double friction_share = 1;
   double force_regularization = 1e-4;  // small cost on lambda^2 (lambda in body weights): unique forces
 };
