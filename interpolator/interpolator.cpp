@@ -44,6 +44,9 @@ std::string validateOptions(const InterpolatorOptions& o) {
   if (!(o.speed_cap > 0)) return "the speed cap must be positive";
   if (o.pyramid_edges != 4 && o.pyramid_edges != kFrictionPyramidEdges)
     return "the friction pyramid's edges must be 4 or " + std::to_string(kFrictionPyramidEdges);
+  if (!(o.support_inset >= 0 && o.support_inset < 0.1)) return "the support inset must be in [0, 0.1) m";
+  if (!(o.support_inset_y < 0.1)) return "the support inset across must be below 0.1 m (negative: the support inset)";
+  if (!(o.friction_share > 0 && o.friction_share <= 1)) return "the friction share must be in (0, 1]";
   if (!(o.link_acceleration_cap > 0 && std::isfinite(o.link_acceleration_cap)))
     return "the link acceleration cap must be positive and finite";
   if (!(o.velocity_share > 0 && o.velocity_share <= 1)) return "the velocity share must be in (0, 1]";
@@ -106,6 +109,9 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
   to.posture.problem.collision_cutoff = opt.collision_cutoff;
   to.posture.problem.pyramid_sides = opt.pyramid_edges;
+  to.posture.problem.support_inset = opt.support_inset;
+  to.posture.problem.support_inset_y = opt.support_inset_y;
+  to.posture.problem.friction_share = opt.friction_share;
   to.posture.ipopt_options = opt.posture_ipopt_options;
   to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};

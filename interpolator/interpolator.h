@@ -39,6 +39,11 @@ struct InterpolatorOptions {
   bool verify_samples = true;
   // Edges of the knots' friction pyramid: 4 or 8 (PostureOptions::pyramid_sides).
   int pyramid_edges = 4;
+  // The knots' stability margins (PostureOptions::support_inset, m, and
+  // friction_share): none by default.
+  double support_inset = 0;
+  double support_inset_y = -1;  // >= 0: across the spot (its y) instead
+  double friction_share = 1;
   // Each posture call bounded by iterations, not time: same input, same output.
   int posture_iterations = 100;
   double collision_cutoff = 0.15;  // m: pairs farther than this at the warm start are left out

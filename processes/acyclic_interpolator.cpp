@@ -56,6 +56,16 @@ int main(int argc, char** argv) {
   app.add_option("--pyramid-edges", o.pyramid_edges,
                  "edges of the knots' friction pyramid: 4 (every other edge of the contract's) or 8 (all)")
       ->capture_default_str();
+  app.add_option("--support-inset", o.support_inset,
+                 "stability margin of the knots: each supporting contact's forces applied this far (m) inside "
+                 "its spot's edges")
+      ->capture_default_str();
+  app.add_option("--support-inset-y", o.support_inset_y,
+                 "the same along each spot's y axis (across a sole) instead, m (negative: --support-inset)")
+      ->capture_default_str();
+  app.add_option("--friction-share", o.friction_share,
+                 "stability margin of the knots: the share of each surface's friction coefficient used, in (0, 1]")
+      ->capture_default_str();
   app.add_option("--link-acceleration-cap", o.link_acceleration_cap,
                  "largest acceleration of any link origin, m/s^2 (joints: the robot file's acceleration_limits)")
       ->capture_default_str();

@@ -53,6 +53,18 @@ int main(int argc, char** argv) {
                  "friction pyramid edges per corner: 4 (every other edge of the contract's) or 8 (all of them)")
       ->check(CLI::IsMember({4, 8}))
       ->capture_default_str();
+  double support_inset = 0, support_inset_y = -1, friction_share = 1;
+  app.add_option("--support-inset-y", support_inset_y,
+                 "the same along each spot's y axis (across a sole) instead, m (negative: --support-inset)")
+      ->capture_default_str();
+  app.add_option("--support-inset", support_inset,
+                 "stability margin: each supporting contact's forces applied this far (m) inside its spot's edges")
+      ->check(CLI::Range(0.0, 0.1))
+      ->capture_default_str();
+  app.add_option("--friction-share", friction_share,
+                 "stability margin: the share of each surface's friction coefficient used, in (0, 1]")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
   app.add_option("--ipopt", ipopt, "a further Ipopt option NAME=VALUE (repeatable)");
   app.add_option("--out", out,
                  "write the witness as a one-stance plan (acyclic.plan/1) with the stance once the change settles "
@@ -95,6 +107,9 @@ int main(int argc, char** argv) {
     o.ipopt_options = ipopt;
     o.distance_engine = *distanceEngineNamed(engine);
     o.problem.pyramid_sides = pyramid_edges;
+    o.problem.support_inset = support_inset;
+    o.problem.support_inset_y = support_inset_y;
+    o.problem.friction_share = friction_share;
     PostureGenerator pg(sc.robot, sc.scene, o);
     const PostureResult res = pg.solve(r);
     std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s\n", toString(res.status), res.iterations,

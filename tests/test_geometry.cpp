@@ -43,6 +43,41 @@ TEST(Geometry, PolygonSignedDistanceAndOrientation) {
   EXPECT_LT((sq.nearestBoundaryPoint({0.5, 0.9}) - Eigen::Vector2d(0.5, 1)).norm(), 1e-12);  // from inside
 }
 
+TEST(Geometry, PolygonInsetMovesEveryEdgeInward) {
+  const ConvexPolygon rect({{-0.077, -0.069}, {0.14, -0.069}, {0.14, 0.069}, {-0.077, 0.069}});
+  const ConvexPolygon a = rect.inset(0.02);
+  ASSERT_EQ(a.size(), 4u);
+  for (const auto& v : a.vertices()) EXPECT_NEAR(rect.signedDistance(v), -0.02, 1e-12);
+  EXPECT_NEAR(a.area(), (0.217 - 0.04) * (0.138 - 0.04), 1e-12);
+  // Capped at three quarters of the centroid's depth (0.069): a quarter of the width left.
+  const ConvexPolygon b = rect.inset(1.0);
+  EXPECT_NEAR(b.area(), (0.217 - 0.1035) * (0.138 - 0.1035), 1e-12);
+  EXPECT_EQ(rect.inset(0).vertices(), rect.vertices());
+  // A short edge between two sharp corners would vanish: scaled instead, every
+  // edge at least d inside.
+  const ConvexPolygon kite({{0, -1}, {4, -0.01}, {4, 0.01}, {0, 1}});
+  const ConvexPolygon k = kite.inset(0.3);
+  ASSERT_EQ(k.size(), 4u);
+  for (const auto& v : k.vertices()) EXPECT_LE(kite.signedDistance(v), -0.3 + 1e-12);
+  EXPECT_THROW(rect.inset(-0.01), std::invalid_argument);
+  // Shrunk by a box: 1 cm along x, 4 cm along y.
+  const ConvexPolygon c = rect.inset(0.01, 0.04);
+  EXPECT_NEAR(c.area(), (0.217 - 0.02) * (0.138 - 0.08), 1e-12);
+  EXPECT_EQ(rect.inset(0.02, 0.02).vertices(), a.vertices());
+  // Capped: the y edges at three quarters of 0.069, x scaled alike.
+  const ConvexPolygon e = rect.inset(0.01, 0.1);
+  const double f = 0.75 * 0.069 / 0.1;
+  EXPECT_NEAR(e.area(), (0.217 - 0.02 * f) * (0.138 - 0.2 * f), 1e-12);
+  // A tilted edge moves by dx |n_x| + dy |n_y|.
+  const ConvexPolygon tri({{0, 0}, {2, 0}, {0, 2}});
+  const ConvexPolygon t = tri.inset(0.1, 0.2);
+  for (const auto& v : t.vertices()) {
+    EXPECT_GE(v.x(), 0.1 - 1e-12);
+    EXPECT_GE(v.y(), 0.2 - 1e-12);
+    EXPECT_LE(v.x() + v.y(), 2 - 0.3 + 1e-12);
+  }
+}
+
 TEST(Geometry, PolygonRejectsBadInput) {
   EXPECT_THROW(ConvexPolygon({{0, 0}, {1, 0}}), std::invalid_argument);
   EXPECT_THROW(ConvexPolygon({{0, 0}, {1, 0}, {2, 0}}), std::invalid_argument);                   // no area

@@ -715,7 +715,9 @@ TEST(Interpolator, BadInputAndCancellation) {
   EXPECT_EQ(t.status, InterpolationResult::Status::InvalidInput);
   EXPECT_NE(t.reason.find("threads"), std::string::npos) << t.reason;
   for (auto bad : {std::function<void(InterpolatorOptions&)>([](InterpolatorOptions& o) { o.pyramid_edges = 6; }),
-                   std::function<void(InterpolatorOptions&)>([](InterpolatorOptions& o) { o.link_acceleration_cap = 0; })}) {
+                   std::function<void(InterpolatorOptions&)>([](InterpolatorOptions& o) { o.link_acceleration_cap = 0; }),
+                   std::function<void(InterpolatorOptions&)>([](InterpolatorOptions& o) { o.support_inset = -0.01; }),
+                   std::function<void(InterpolatorOptions&)>([](InterpolatorOptions& o) { o.friction_share = 1.5; })}) {
     InterpolatorOptions o;
     bad(o);
     EXPECT_EQ(interpolate(plan, sc, o).status, InterpolationResult::Status::InvalidInput);

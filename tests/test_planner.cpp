@@ -252,7 +252,9 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
                                              "failure_memory_angle: 0.5, posture_linear_solver: mumps, "
                                              "posture_lbfgs_in_kkt: true, alternative_step: 0.05, "
                                              "posture_stop_at_restoration: false, posture_mu_oracle: probing, "
-                                             "posture_distance_engine: convex, posture_pyramid_edges: 8}\n"));
+                                             "posture_distance_engine: convex, posture_pyramid_edges: 8, "
+                                             "posture_support_inset: 0.02, posture_friction_share: 0.8, "
+                                             "posture_support_inset_y: 0.03}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -275,6 +277,12 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_EQ(plannerParameters(plain).posture.distance_engine, DistanceEngine::Fcl);  // the planner's default
   EXPECT_EQ(p.posture.problem.pyramid_sides, 8);
   EXPECT_EQ(plannerParameters(plain).posture.problem.pyramid_sides, 4);  // the planner's default
+  EXPECT_DOUBLE_EQ(p.posture.problem.support_inset, 0.02);
+  EXPECT_DOUBLE_EQ(p.posture.problem.friction_share, 0.8);
+  EXPECT_DOUBLE_EQ(p.posture.problem.support_inset_y, 0.03);
+  EXPECT_LT(plannerParameters(plain).posture.problem.support_inset_y, 0.0);  // as support_inset
+  EXPECT_EQ(plannerParameters(plain).posture.problem.support_inset, 0.0);  // no margins unless asked
+  EXPECT_EQ(plannerParameters(plain).posture.problem.friction_share, 1.0);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {max_nodes: 0}\n", "planner.max_nodes"},
            {"planner: {max_node: 5}\n", "planner.max_node"},
@@ -289,7 +297,11 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {posture_lbfgs_in_kkt: sometimes}\n", "planner.posture_lbfgs_in_kkt"},
            {"planner: {posture_mu_oracle: fast}\n", "planner.posture_mu_oracle"},
            {"planner: {posture_distance_engine: bullet}\n", "planner.posture_distance_engine"},
-           {"planner: {posture_pyramid_edges: 6}\n", "planner.posture_pyramid_edges"}}) {
+           {"planner: {posture_pyramid_edges: 6}\n", "planner.posture_pyramid_edges"},
+           {"planner: {posture_support_inset: -0.01}\n", "planner.posture_support_inset"},
+           {"planner: {posture_friction_share: 1.2}\n", "planner.posture_friction_share"},
+           {"planner: {posture_support_inset_y: -0.02}\n", "planner.posture_support_inset_y"},
+           {"planner: {posture_friction_share: 0}\n", "planner.posture_friction_share"}}) {
     const Scenario sc = Scenario::load(dir.write("c.yaml", text + bad));
     try {
       plannerParameters(sc);

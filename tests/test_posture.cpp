@@ -97,10 +97,22 @@ Eigen::VectorXd numericCostGradient(PostureProblem& p, const Eigen::VectorXd& x)
 
 }  // namespace
 
+// Stability margins: the statics rows' corners and generators change (and
+// so every derivative through them).
+PostureOptions withMargins() {
+  PostureOptions o;
+  o.support_inset = 0.02;
+  o.support_inset_y = 0.03;
+  o.friction_share = 0.8;
+  return o;
+}
+
 TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
   const Scenario& sc = chair();
   auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
-  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), {});
+  for (const PostureOptions& options : {PostureOptions{}, withMargins()}) {
+  SCOPED_TRACE(options.support_inset > 0 ? "with margins" : "without margins");
+  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), options);
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0, 0.05);
   for (int trial = 0; trial < 2; ++trial) {
@@ -142,6 +154,7 @@ TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
           EXPECT_TRUE(s.count({r, c})) << "row " << r << " col " << c;
         }
   }
+  }
 }
 
 TEST(PostureProblem, SpotTargetsOfTheReferenceCostMatchFiniteDifferences) {
@@ -179,7 +192,9 @@ TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
   // terms, checked loosely) against differences of the constraint Jacobian.
   const Scenario& sc = chair();
   auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
-  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), {});
+  for (const PostureOptions& options : {PostureOptions{}, withMargins()}) {
+  SCOPED_TRACE(options.support_inset > 0 ? "with margins" : "without margins");
+  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), options);
   std::mt19937 rng(2);
   std::normal_distribution<double> n(0, 0.05);
   Eigen::VectorXd x = p.initialPoint();
@@ -209,6 +224,7 @@ TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
   EXPECT_LT(block(3, 3, 3, 3), 1e-3) << "base rotation x base rotation";
   EXPECT_LT(block(nq, 3, 0, nq + 3), 1e-6) << "floating contact";
   EXPECT_LT(block(nq + 3, nx - nq - 3, 0, nq), 1e-6) << "forces x configuration";
+  }
 }
 
 // The chair's start stance with the left wrist held at a world pose (the
@@ -443,6 +459,51 @@ TEST(PostureGenerator, HalfSittingDoubleSupport) {  // (b)
   for (const auto& c : res.forces)
     for (const auto& f : c.forces) fz += f.z();
   EXPECT_NEAR(fz, sc.robot->totalMass() * 9.81, 1e-3);
+}
+
+// On the left foot alone (the right one on the floor but not loaded): the
+// CoM is above the centre of pressure. Without margins the posture nearest
+// half-sitting puts it on the sole's edge; with an inset of 2 cm it is at
+// least 2 cm inside every edge, and the friction used within its share.
+TEST(PostureGenerator, StabilityMarginsKeepTheCentreOfPressureInside) {
+  const Scenario& sc = chair();
+  const Configuration hs = sc.robot->posture("half_sitting");
+  Configuration at = hs;
+  at.base_position = Eigen::Vector3d(-0.6, -0.8, hs.base_position.z());  // in the open
+  const std::vector<ContactSpec> stance = {contactOf(sc, "r_sole", "floor", false, at),
+                                           contactOf(sc, "l_sole", "floor", true, at)};
+  const ConvexPolygon& sole = sc.robot->spots()[stance[1].spot].polygon;
+  const Eigen::Isometry3d frame = contactFrame(sc.scene->surfaces()[stance[1].surface], stance[1].placement);
+  auto comDepth = [&](const PostureResult& res) {  // the CoM's distance inside the sole's edges
+    Kinematics k(sc.robot);
+    k.setConfiguration(res.configuration);
+    const Eigen::Vector3d c = frame.inverse() * k.centerOfMass();
+    return -sole.signedDistance(c.head<2>());
+  };
+  PostureRequest r;
+  r.contacts = stance;
+  r.initial_guess = at;
+  r.cost = std::make_shared<ReferencePostureCost>(at);
+  PostureGeneratorOptions plain;
+  const PostureResult edge = PostureGenerator(sc.robot, sc.scene, plain).solve(r);
+  ASSERT_TRUE(edge.success()) << toString(edge.status) << ": " << edge.reason;
+  expectValid(sc, edge, stance);
+  EXPECT_LT(comDepth(edge), 0.01);
+  PostureGeneratorOptions margins;
+  margins.problem.support_inset = 0.02;
+  margins.problem.friction_share = 0.8;
+  const PostureResult inside = PostureGenerator(sc.robot, sc.scene, margins).solve(r);
+  ASSERT_TRUE(inside.success()) << toString(inside.status) << ": " << inside.reason;
+  expectValid(sc, inside, stance);
+  EXPECT_GT(comDepth(inside), 0.02 - 1e-4);
+  const Eigen::Vector3d n = frame.linear().col(2);
+  const double mu = sc.scene->surfaces()[stance[1].surface].friction;
+  for (const auto& c : inside.forces)
+    for (std::size_t k = 0; k < c.forces.size(); ++k) {
+      const Eigen::Vector3d p = frame.inverse() * c.points[k];
+      EXPECT_NEAR(-sole.signedDistance(p.head<2>()), 0.02, 1e-9);  // a corner of the inset polygon
+      EXPECT_LE(coneRatio(c.forces[k], n, mu), 0.8 + 1e-9);
+    }
 }
 
 namespace {

@@ -86,6 +86,72 @@ double ConvexPolygon::area() const {
   return 0.5 * a2;
 }
 
+ConvexPolygon ConvexPolygon::inset(double d) const {
+  if (!(d >= 0) || !std::isfinite(d)) throw std::invalid_argument("polygon inset: expected a finite d >= 0");
+  if (d == 0) return *this;
+  const Eigen::Vector2d c = centroid();
+  const double h = -signedDistance(c);  // the centroid's distance to the nearest edge (> 0: convex, positive area)
+  d = std::min(d, 0.75 * h);
+  const std::size_t n = v_.size();
+  std::vector<Eigen::Vector2d> normal(n);  // outward unit normal of edge i (v_i to v_i+1)
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d e = v_[(i + 1) % n] - v_[i];
+    normal[i] = Eigen::Vector2d(e.y(), -e.x()).normalized();
+  }
+  // Vertex i joins edges i-1 and i: the point d inside both lines.
+  std::vector<Eigen::Vector2d> w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = normal[(i + n - 1) % n];
+    const Eigen::Vector2d& b = normal[i];
+    w[i] = v_[i] - d * (a + b) / (1 + a.dot(b));
+  }
+  bool kept = true;  // every edge keeps its direction: none vanished
+  for (std::size_t i = 0; i < n && kept; ++i)
+    kept = (w[(i + 1) % n] - w[i]).dot(v_[(i + 1) % n] - v_[i]) > 0;
+  if (!kept) {
+    const double s = 1 - d / h;  // edge i moves inward by (1 - s) * h_i >= d
+    for (std::size_t i = 0; i < n; ++i) w[i] = c + s * (v_[i] - c);
+  }
+  return ConvexPolygon(std::move(w));
+}
+
+ConvexPolygon ConvexPolygon::inset(double dx, double dy) const {
+  if (!(dx >= 0 && dy >= 0) || !std::isfinite(dx) || !std::isfinite(dy))
+    throw std::invalid_argument("polygon inset: expected finite dx, dy >= 0");
+  if (dx == dy) return inset(dx);
+  const Eigen::Vector2d c = centroid();
+  const std::size_t n = v_.size();
+  std::vector<Eigen::Vector2d> normal(n);  // outward unit normal of edge i (v_i to v_i+1)
+  std::vector<double> d(n), h(n);          // edge i's move inward, the centroid's distance to it
+  double scale = 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d e = v_[(i + 1) % n] - v_[i];
+    normal[i] = Eigen::Vector2d(e.y(), -e.x()).normalized();
+    d[i] = dx * std::abs(normal[i].x()) + dy * std::abs(normal[i].y());
+    h[i] = normal[i].dot(v_[i] - c);
+    if (d[i] > 0.75 * h[i]) scale = std::min(scale, 0.75 * h[i] / d[i]);
+  }
+  for (double& di : d) di *= scale;
+  // Vertex i joins edges i-1 and i: the point d[i-1] inside the first, d[i] inside the second.
+  std::vector<Eigen::Vector2d> w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t a = (i + n - 1) % n;
+    Eigen::Matrix2d M;
+    M.row(0) = normal[a].transpose();
+    M.row(1) = normal[i].transpose();
+    w[i] = v_[i] - M.inverse() * Eigen::Vector2d(d[a], d[i]);
+  }
+  bool kept = true;  // every edge keeps its direction: none vanished
+  for (std::size_t i = 0; i < n && kept; ++i)
+    kept = (w[(i + 1) % n] - w[i]).dot(v_[(i + 1) % n] - v_[i]) > 0;
+  if (!kept) {
+    double s = 1;  // edge i moves inward by (1 - s) * h_i >= d_i
+    for (std::size_t i = 0; i < n; ++i) s = std::min(s, 1 - d[i] / h[i]);
+    for (std::size_t i = 0; i < n; ++i) w[i] = c + s * (v_[i] - c);
+  }
+  return ConvexPolygon(std::move(w));
+}
+
 Eigen::Vector2d ConvexPolygon::centroid() const {
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   double a2 = 0;

@@ -35,6 +35,20 @@ class ConvexPolygon {
   }
   double area() const;
   Eigen::Vector2d centroid() const;
+  // The polygon shrunk by d >= 0: every edge moved inward by d along its
+  // normal, so that its points are at least d inside every edge of this one.
+  // d is capped at three quarters of the centroid's distance to the nearest
+  // edge, so that a small polygon keeps a positive size (at least a quarter
+  // of its own about the centroid). Where moving the edges would make one vanish (a short edge
+  // between two sharp corners), the polygon is scaled about the centroid
+  // instead, each edge moving inward by at least the capped d.
+  ConvexPolygon inset(double d) const;
+  // Shrunk by a box: the points p such that p + [-dx, dx] x [-dy, dy] is
+  // inside (an edge of outward normal n moved inward by dx |n_x| + dy |n_y|);
+  // (dx, dy) scaled down where an edge would move more than three quarters
+  // of the centroid's distance to it, scaled about the centroid where one
+  // would vanish (as inset(d), which it equals for dx = dy = d).
+  ConvexPolygon inset(double dx, double dy) const;
 
  private:
   std::vector<Eigen::Vector2d> v_;

@@ -46,6 +46,12 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
   if (opt_.pyramid_sides < 3 || kFrictionPyramidEdges % opt_.pyramid_sides != 0)
     throw std::invalid_argument("pyramid_sides = " + std::to_string(opt_.pyramid_sides) + ": expected a divisor of " +
                                 std::to_string(kFrictionPyramidEdges) + " of at least 3");
+  if (!(opt_.support_inset >= 0 && std::isfinite(opt_.support_inset)))
+    throw std::invalid_argument("support_inset: expected a finite length >= 0 (m)");
+  if (!(opt_.support_inset_y < 0 || std::isfinite(opt_.support_inset_y)))
+    throw std::invalid_argument("support_inset_y: expected a finite length (m; < 0: support_inset)");
+  if (!(opt_.friction_share > 0 && opt_.friction_share <= 1))
+    throw std::invalid_argument("friction_share: expected a share in (0, 1]");
   if (req_.initial_guess.joints.size() != robot_->numJoints())
     throw std::invalid_argument("initial guess has " + std::to_string(req_.initial_guess.joints.size()) +
                                 " joints, the robot " + std::to_string(robot_->numJoints()));
@@ -109,12 +115,14 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
     sup.contact = ci;
     sup.link = robot_->spots()[c.spot].link;
     const Eigen::Isometry3d T = contactFrame(s, c.placement);
-    for (const auto& v : robot_->spots()[c.spot].polygon.vertices()) sup.corners.push_back(T * Eigen::Vector3d(v.x(), v.y(), 0));
+    const ConvexPolygon polygon = robot_->spots()[c.spot].polygon.inset(
+        opt_.support_inset, opt_.support_inset_y >= 0 ? opt_.support_inset_y : opt_.support_inset);
+    for (const auto& v : polygon.vertices()) sup.corners.push_back(T * Eigen::Vector3d(v.x(), v.y(), 0));
     const Eigen::Matrix3d R = s.frame.linear();
+    const double mu = opt_.friction_share * s.friction;
     for (int m = 0; m < opt_.pyramid_sides; ++m) {
       const double phi = 2 * M_PI * m / opt_.pyramid_sides;
-      sup.generators.push_back(
-          (R.col(2) + s.friction * (std::cos(phi) * R.col(0) + std::sin(phi) * R.col(1))).normalized());
+      sup.generators.push_back((R.col(2) + mu * (std::cos(phi) * R.col(0) + std::sin(phi) * R.col(1))).normalized());
     }
     sup.lambda0 = nx;
     nx += static_cast<int>(sup.corners.size() * sup.generators.size());

@@ -15,7 +15,8 @@
 //               angle (1: x_s . y_t = 0)
 //   floating    (x, y) inside the search polygon; each spot-polygon corner
 //               inside the surface polygon
-//   statics     h = (g(q) - sum J^T f) / weight over the supporting contacts' corners:
+//   statics     h = (g(q) - sum J^T f) / weight over the supporting contacts' corners
+//               (moved inward by PostureOptions::support_inset):
 //               6 base rows = 0 (forces; moments about the world origin),
 //               30 joint rows within the torque limits
 //   collision   signed distance >= margin for each active pair
@@ -99,6 +100,24 @@ struct PostureOptions {
   // many edges span its pyramid), torques within this share of their limits.
   double min_corner_force = 8e-3;
   double torque_share = 0.98;
+  // Stability margins (0 and 1: none, the witnesses on the edges of what
+  // the check accepts). Executing a plan on compliant soles with servos that
+  // do not track its forces needs them: a centre of pressure at a sole's
+  // edge rolls the robot over it.
+  // support_inset (m): the forces of each supporting contact applied at the
+  // corners of its spot polygon shrunk by this much (ConvexPolygon::inset:
+  // every edge moved inward, capped at three quarters of the centroid's
+  // distance to the nearest edge), so that its centre of pressure stays this far inside the
+  // real edges. friction_share: the pyramid's edges at friction_share * mu
+  // (in (0, 1]): tangential forces within that share of the friction.
+  // Both only shrink the set of forces the generator may use (points inside
+  // the spot, edges inside the contract's pyramid): its witnesses still pass
+  // the check, which is unchanged.
+  double support_inset = 0;
+  // support_inset_y >= 0: the inset along the spot's y axis instead (across a
+  // sole; along it, x, support_inset): the spot eroded by a box (ConvexPolygon::inset(dx, dy)).
+  double support_inset_y = -1;
+  double friction_share = 1;
   double force_regularization = 1e-4;  // small cost on lambda^2 (lambda in body weights): unique forces
 };
 

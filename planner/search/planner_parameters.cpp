@@ -11,7 +11,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
                "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
-               "posture_pyramid_edges",
+               "posture_pyramid_edges", "posture_support_inset", "posture_support_inset_y", "posture_friction_share",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
@@ -73,6 +73,21 @@ PlannerParameters plannerParameters(const Scenario& sc) {
       f["posture_pyramid_edges"].fail("4 or " + std::to_string(kFrictionPyramidEdges) +
                                       " (edges of the contract's friction pyramid)");
     p.posture.problem.pyramid_sides = v;
+  }
+  if (f.has("posture_support_inset")) {
+    const double v = f["posture_support_inset"].number();
+    if (!(v >= 0 && v < 0.1)) f["posture_support_inset"].fail("a length in [0, 0.1) m");
+    p.posture.problem.support_inset = v;
+  }
+  if (f.has("posture_support_inset_y")) {
+    const double v = f["posture_support_inset_y"].number();
+    if (!(v >= 0 && v < 0.1)) f["posture_support_inset_y"].fail("a length in [0, 0.1) m");
+    p.posture.problem.support_inset_y = v;
+  }
+  if (f.has("posture_friction_share")) {
+    const double v = f["posture_friction_share"].number();
+    if (!(v > 0 && v <= 1)) f["posture_friction_share"].fail("a share of the friction coefficient in (0, 1]");
+    p.posture.problem.friction_share = v;
   }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
