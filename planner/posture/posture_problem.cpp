@@ -72,7 +72,7 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
   };
   for (const auto& c : req_.contacts) {
     checkContact(c.spot, c.surface);
-    // A fixed contact's spot polygon must lie on its surface (DESIGN.md section 9).
+    // A fixed contact's spot polygon must lie on its surface (docs/design.md section 9).
     const Surface& s = scene_->surfaces()[c.surface];
     for (const auto& v : robot_->spots()[c.spot].polygon.vertices()) {
       const Eigen::Vector2d p = Eigen::Vector2d(c.placement.x, c.placement.y) +

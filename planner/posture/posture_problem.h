@@ -1,5 +1,5 @@
 #pragma once
-// The posture generator's nonlinear program (DESIGN.md section 6), evaluated
+// The posture generator's nonlinear program (docs/design.md section 6), evaluated
 // without Ipopt so that every derivative can be tested on its own.
 //
 // Variables x = [ configuration (tangent offset from the initial guess: base
