@@ -394,7 +394,9 @@ TEST(TimeLaw, AccelerationsWithinTheLimitsVelocitiesTheDerivativeOfPositions) {
   EXPECT_LE(worst_gap, 0.5);
   // Through the reversal the arm stops: its velocity changes sign only through (near) zero.
   for (int i = 0; i < piece.steps(); ++i)
-    if (v[i][arm] * v[i + 1][arm] < 0) EXPECT_LT(std::abs(v[i][arm] - v[i + 1][arm]), sc.robot->joints()[arm].acceleration * opt.dt);
+    if (v[i][arm] * v[i + 1][arm] < 0) {
+      EXPECT_LT(std::abs(v[i][arm] - v[i + 1][arm]), sc.robot->joints()[arm].acceleration * opt.dt);
+    }
 }
 
 // A move of 2 mrad, as a support flip's, takes the time its acceleration needs:
