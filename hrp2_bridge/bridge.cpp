@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "planner/common/fmt.h"
+
 namespace acyclic::hrp2 {
 
 namespace {
@@ -14,11 +16,6 @@ constexpr double kForeignWindow = 0.5;             // s: the start guard's memor
 std::int64_t us(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e6)); }
 double ms(std::int64_t micro) { return micro * 1e-3; }
 
-std::string fmt(const char* f, double a = 0, double b = 0, double c = 0) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 }  // namespace
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "planner/common/fmt.h"
+
 namespace acyclic::hrp2 {
 
 namespace {
@@ -11,11 +13,6 @@ namespace {
 // that sits exactly on a limit.
 constexpr double kSlack = 1e-9;
 
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 std::string at(int i, double t) { return "sample " + std::to_string(i) + fmt(" (t = %.3f s)", t); }
 

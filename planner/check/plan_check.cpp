@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "planner/common/fmt.h"
 #include "planner/scene/friction.h"
 
 namespace acyclic {
@@ -12,16 +13,6 @@ bool PlanReport::valid() const {
     if (!s.valid()) return false;
   return sequence_violations.empty();
 }
-
-namespace {
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
-
-}  // namespace
 
 CheckPart checkReportedForces(const PlanStance& st, const Scenario& sc, Kinematics& kin, double* worst_out) {
   CheckPart p;

@@ -5,15 +5,11 @@
 #include <cstdio>
 #include <limits>
 
+#include "planner/common/fmt.h"
+
 namespace acyclic {
 
 namespace {
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 void add(TrajectoryCheckPart& p, const std::string& v, int max) {
   if (static_cast<int>(p.violations.size()) < max) p.violations.push_back(v);

@@ -6,15 +6,9 @@
 #include <set>
 #include <sstream>
 
-namespace acyclic {
+#include "planner/common/fmt.h"
 
-namespace {
-std::string fmt(const char* f, double a) {
-  char buf[128];
-  std::snprintf(buf, sizeof buf, f, a);
-  return buf;
-}
-}  // namespace
+namespace acyclic {
 
 bool ValidityReport::valid() const {
   for (const auto& p : parts)
