@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -88,49 +89,32 @@ double ConvexPolygon::area() const {
 
 ConvexPolygon ConvexPolygon::inset(double d) const {
   if (!(d >= 0) || !std::isfinite(d)) throw std::invalid_argument("polygon inset: expected a finite d >= 0");
-  if (d == 0) return *this;
-  const Eigen::Vector2d c = centroid();
-  const double h = -signedDistance(c);  // the centroid's distance to the nearest edge (> 0: convex, positive area)
-  d = std::min(d, 0.75 * h);
-  const std::size_t n = v_.size();
-  std::vector<Eigen::Vector2d> normal(n);  // outward unit normal of edge i (v_i to v_i+1)
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d e = v_[(i + 1) % n] - v_[i];
-    normal[i] = Eigen::Vector2d(e.y(), -e.x()).normalized();
-  }
-  // Vertex i joins edges i-1 and i: the point d inside both lines.
-  std::vector<Eigen::Vector2d> w(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& a = normal[(i + n - 1) % n];
-    const Eigen::Vector2d& b = normal[i];
-    w[i] = v_[i] - d * (a + b) / (1 + a.dot(b));
-  }
-  bool kept = true;  // every edge keeps its direction: none vanished
-  for (std::size_t i = 0; i < n && kept; ++i)
-    kept = (w[(i + 1) % n] - w[i]).dot(v_[(i + 1) % n] - v_[i]) > 0;
-  if (!kept) {
-    const double s = 1 - d / h;  // edge i moves inward by (1 - s) * h_i >= d
-    for (std::size_t i = 0; i < n; ++i) w[i] = c + s * (v_[i] - c);
-  }
-  return ConvexPolygon(std::move(w));
+  return insetEdges([d](const Eigen::Vector2d&) { return d; });
 }
 
 ConvexPolygon ConvexPolygon::inset(double dx, double dy) const {
   if (!(dx >= 0 && dy >= 0) || !std::isfinite(dx) || !std::isfinite(dy))
     throw std::invalid_argument("polygon inset: expected finite dx, dy >= 0");
-  if (dx == dy) return inset(dx);
+  if (dx == dy) return inset(dx);  // a disc's erosion, not a square's: edges move by d whatever their direction
+  return insetEdges([dx, dy](const Eigen::Vector2d& n) { return dx * std::abs(n.x()) + dy * std::abs(n.y()); });
+}
+
+ConvexPolygon ConvexPolygon::insetEdges(const std::function<double(const Eigen::Vector2d&)>& move) const {
   const Eigen::Vector2d c = centroid();
   const std::size_t n = v_.size();
   std::vector<Eigen::Vector2d> normal(n);  // outward unit normal of edge i (v_i to v_i+1)
   std::vector<double> d(n), h(n);          // edge i's move inward, the centroid's distance to it
   double scale = 1;
+  bool moves = false;
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d e = v_[(i + 1) % n] - v_[i];
     normal[i] = Eigen::Vector2d(e.y(), -e.x()).normalized();
-    d[i] = dx * std::abs(normal[i].x()) + dy * std::abs(normal[i].y());
+    d[i] = move(normal[i]);
     h[i] = normal[i].dot(v_[i] - c);
+    moves = moves || d[i] > 0;
     if (d[i] > 0.75 * h[i]) scale = std::min(scale, 0.75 * h[i] / d[i]);
   }
+  if (!moves) return *this;
   for (double& di : d) di *= scale;
   // Vertex i joins edges i-1 and i: the point d[i-1] inside the first, d[i] inside the second.
   std::vector<Eigen::Vector2d> w(n);

@@ -2,6 +2,7 @@
 // Small geometric helpers shared by the model, the scene and the checks.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,10 +48,14 @@ class ConvexPolygon {
   // inside (an edge of outward normal n moved inward by dx |n_x| + dy |n_y|);
   // (dx, dy) scaled down where an edge would move more than three quarters
   // of the centroid's distance to it, scaled about the centroid where one
-  // would vanish (as inset(d), which it equals for dx = dy = d).
+  // would vanish (as inset(d)). For dx = dy it is inset(dx).
   ConvexPolygon inset(double dx, double dy) const;
 
  private:
+  // Both insets: edge i (outward unit normal n) moved inward by move(n),
+  // capped and, where an edge would vanish, scaled about the centroid.
+  ConvexPolygon insetEdges(const std::function<double(const Eigen::Vector2d&)>& move) const;
+
   std::vector<Eigen::Vector2d> v_;
 };
 
