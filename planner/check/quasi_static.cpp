@@ -1,6 +1,7 @@
 #include "planner/check/quasi_static.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -75,6 +76,20 @@ struct Lp {
     return true;
   }
 };
+
+// The contract's friction facets in the surface frame: outward direction
+// (cos, sin) and the cone's share where the facet lies (cos(pi/E)).
+struct Facet {
+  double cos, sin, inset;
+};
+const std::array<Facet, kFrictionPyramidEdges> kFacets = [] {
+  std::array<Facet, kFrictionPyramidEdges> f{};
+  for (int m = 0; m < kFrictionPyramidEdges; ++m) {
+    const double a = 2 * M_PI * (m + 0.5) / kFrictionPyramidEdges;
+    f[m] = {std::cos(a), std::sin(a), std::cos(M_PI / kFrictionPyramidEdges)};
+  }
+  return f;
+}();
 
 }  // namespace
 
@@ -159,12 +174,10 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     // Friction: the contract's pyramid inscribed in the cone (friction.h),
     // by its facets: mu cos(pi/E) f_n - (cos a f_t1 + sin a f_t2) >= s (LP 1)
     // or >= 0 (LP 2), a = 2 pi (m + 1/2) / E the facet's outward direction.
-    const double inset = std::cos(M_PI / kFrictionPyramidEdges);
     for (std::size_t k = 0; k < corners.size(); ++k)
-      for (int m = 0; m < kFrictionPyramidEdges; ++m) {
-        const double a = 2 * M_PI * (m + 0.5) / kFrictionPyramidEdges;
+      for (const Facet& f : kFacets) {
         std::vector<std::pair<int, double>> row = {
-            {3 * k, corners[k].mu * inset}, {3 * k + 1, -std::cos(a)}, {3 * k + 2, -std::sin(a)}};
+            {3 * k, corners[k].mu * f.inset}, {3 * k + 1, -f.cos}, {3 * k + 2, -f.sin}};
         if (margin_lp) row.push_back({extra, -1.0});
         lp.addRow(row, 0, COIN_DBL_MAX);
       }

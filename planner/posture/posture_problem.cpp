@@ -233,7 +233,7 @@ void PostureProblem::bounds(Eigen::VectorXd& xl, Eigen::VectorXd& xu, Eigen::Vec
     xl[x_float_ + 2] = req_.floating->volume.theta_min;
     xu[x_float_ + 2] = req_.floating->volume.theta_max;
   }
-  for (int c = x_lambda_; c < nx_; ++c) xl[c] = opt_.min_corner_force / opt_.pyramid_sides;
+  for (int c = x_lambda_; c < nx_; ++c) xl[c] = minCoefficient();
 
   gl = Eigen::VectorXd::Zero(ng_);
   gu = Eigen::VectorXd::Zero(ng_);
@@ -307,7 +307,7 @@ Eigen::VectorXd PostureProblem::initialPoint() const {
     // a few projected gradient steps toward the non-negative least-squares solution
     const double step = 1.0 / AtA.norm();
     for (int it = 0; it < 200; ++it) lam = (lam - step * (AtA * lam - A.transpose() * b)).cwiseMax(0.0);
-    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(opt_.min_corner_force / opt_.pyramid_sides);
+    x.segment(x_lambda_, n_lambda_) = lam.cwiseMax(minCoefficient());
   }
   return x;
 }

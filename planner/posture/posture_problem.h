@@ -173,6 +173,8 @@ class PostureProblem {
   void addCollisionPairs(const std::vector<int>& pairs);
 
  private:
+  // Each pyramid coefficient's floor: the corner's least force split among its edges.
+  double minCoefficient() const { return opt_.min_corner_force / opt_.pyramid_sides; }
   struct Support {             // a supporting contact's force model
     int contact;
     int link;
