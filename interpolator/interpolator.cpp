@@ -103,6 +103,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   to.repair_step = opt.repair_step;
   to.plan_body_path = opt.plan_body_path;
   to.free_limb_paths = opt.free_limb_paths;
+  to.limb_joint_paths = opt.limb_joint_paths;
   to.refine_depth = opt.refine_depth;
   to.wide_clearance = opt.wide_clearance;
   to.posture.max_iterations = opt.posture_iterations;

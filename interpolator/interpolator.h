@@ -31,6 +31,7 @@ struct InterpolatorOptions {
   double repair_step = 0.05;     // m: via-point height added per attempt
   bool plan_body_path = true;    // after them, the body's path planned with OMPL (body_path_planner.h)
   bool free_limb_paths = true;   // then all again, the free limbs' ends on paths of their own (transition.h)
+  bool limb_joint_paths = true;  // there, a free limb swept through an obstacle on joints planned with OMPL
   double wide_clearance = 0.003;  // m: a fixed-contact transition's last try, its knots this much farther from obstacles
   int refine_depth = 3;
   // Check every output sample with the validity contract (and refine where

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "interpolator/body_path_planner.h"
+#include "interpolator/limb_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/common/geometry.h"
 #include "planner/collision/collision_model.h"
@@ -117,9 +118,18 @@ struct TransitionSolver::Attempt {
   std::vector<MotionPiece> pieces;
 };
 
+struct TransitionSolver::FreeEnd {
+  int spot;
+  BodyPath path;
+  // The limb's joints planned around what their interpolation sweeps it
+  // through (limb_path_planner.h); then the knots take them as reference
+  // instead of pulling the end along `path`.
+  std::optional<LimbJointPath> joints;
+};
+
 TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options)
     : sc_(sc), opt_(std::move(options)), generator_(sc.robot, sc.scene, opt_.posture), checker_(sc.robot, sc.scene),
-      kin_(sc.robot) {
+      kin_(sc.robot), collisions_(sc.robot, sc.scene) {
   if (opt_.steps < 1) throw std::invalid_argument("steps must be at least 1");
   if (!(opt_.wide_clearance >= 0)) throw std::invalid_argument("wide_clearance must be non-negative");
   if (opt_.wide_clearance > 0) {
@@ -160,24 +170,42 @@ struct Refiner {
   }
 
   // Appends the refined knots strictly after (pa, a) up to and including (pb, b).
+  // `converging`: the halving that made this segment split its parent in two (halved()).
   bool segment(double pa, const Configuration& a, double pb, const Configuration& b, int level,
-               std::vector<Configuration>& out, std::vector<double>& out_params) {
+               std::vector<Configuration>& out, std::vector<double>& out_params, bool converging = false) {
     std::string why;
     if (midValid(a, b, &why)) {
       out.push_back(b);
       out_params.push_back(pb);
       return true;
     }
-    if (level >= depth) {
-      *reason = "between two knots, after " + std::to_string(depth) + " refinements: " + why;
+    // Past `depth` halvings, only while the knots converge (converging()):
+    // the drift of a held contact between two knots far apart, which each
+    // halving divides by four, wants a few more; a jump between two branches
+    // of the inverse kinematics, which no halving shortens, does not.
+    if (level >= depth && !(level < kMaxDepth && converging)) {
+      *reason = "between two knots, after " + std::to_string(level) + " refinements: " + why;
       return false;
     }
     const double pm = 0.5 * (pa + pb);
     const std::optional<Configuration> m = solveAt(pm, lerp(a, b, 0.5));
     if (!m) return false;
     ++*refinements;
-    return segment(pa, a, pm, *m, level + 1, out, out_params) && segment(pm, *m, pb, b, level + 1, out, out_params);
+    const bool halves = halved(a, *m, b);
+    return segment(pa, a, pm, *m, level + 1, out, out_params, halves) &&
+           segment(pm, *m, pb, b, level + 1, out, out_params, halves);
   }
+
+  // Whether the knot found in the middle splits the segment into two shorter
+  // ones (each at most kConverging of the whole, in the largest coordinate):
+  // the knots lie on one continuous branch.
+  static bool halved(const Configuration& a, const Configuration& m, const Configuration& b) {
+    const double whole = difference(a, b).cwiseAbs().maxCoeff();
+    return std::max(difference(a, m).cwiseAbs().maxCoeff(), difference(m, b).cwiseAbs().maxCoeff()) <=
+           kConverging * whole;
+  }
+  static constexpr int kMaxDepth = 7;
+  static constexpr double kConverging = 0.75;
 
   bool refine(const std::vector<double>& params, const std::vector<Configuration>& knots,
               std::vector<Configuration>& out, std::vector<double>& out_params) {
@@ -207,8 +235,11 @@ struct Refiner {
           if (p.checked && !p.ok()) why = p.name + ": " + p.violations[0];
       }
       if (bad.empty()) return true;
-      if (round >= depth) {
-        *reason = "a sample between two knots, after " + std::to_string(depth) + " rounds of refinement: " + why;
+      // A sample's violation shrinks with its segment (a finger grazing the
+      // table top by 0.08 mm): a few more rounds than `depth`, which cost
+      // one knot per failing segment.
+      if (round >= std::max(depth, kMaxDepth)) {
+        *reason = "a sample between two knots, after " + std::to_string(round) + " rounds of refinement: " + why;
         return false;
       }
       for (auto it = bad.rbegin(); it != bad.rend(); ++it) {  // from the last, so that indices stay valid
@@ -230,24 +261,45 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   TransitionOutcome out;
   Attempt at;
   at.cancel = cancel;
-  if (d.kind == TransitionDesign::Kind::Fixed) {
+  // A body that only reaches (or only leaves) a surface and already touches
+  // it where the other witness has it (a wrist laid on the table beside the
+  // forearm already there, as the witness placed it) does not move: the
+  // transition holds the other stance's contacts, that one touching, as a
+  // support flip does (a Move's path of zero length leaves the posture
+  // generator an over-determined body).
+  const std::optional<TransitionDesign> still = stillBody(plan, d);
+  const TransitionDesign& fd = still ? *still : d;
+  if (fd.kind == TransitionDesign::Kind::Fixed) {
     // First the knots nearest the witnesses' interpolation. When it cuts
     // through an obstacle the knots slide along it at the collision margin,
     // and their optimum can jump from one branch to another between two steps
     // (a trunk along a table's edge, a knee by 0.06 rad), a jump no refinement
     // makes valid: then each knot also near its neighbour, as a Move's.
     // Last, both again with more clearance for the knots (wide_clearance).
+    // Then, a free limb (an arm) that the witnesses' interpolation sweeps
+    // through an obstacle on its joints planned around it (limb_path_planner.h),
+    // with the knots near the witnesses', then each also near its neighbour.
     std::string reasons;
-    for (int attempt = 0; attempt < 4 && !out.ok && !at.cancelled; ++attempt) {
-      const bool follow = attempt % 2 == 1, wide = attempt >= 2;
-      if (wide && !wide_generator_) break;
+    std::vector<LimbJointPath> limbs;
+    for (int attempt = 0; attempt < 6 && !out.ok && !at.cancelled; ++attempt) {
+      const bool follow = attempt % 2 == 1, wide = attempt == 2 || attempt == 3, planned = attempt >= 4;
+      if (wide && !wide_generator_) continue;
+      if (planned && attempt == 4) {
+        if (!opt_.free_limb_paths || !opt_.limb_joint_paths) break;
+        const Configuration& q0 = plan.stances[fd.from].configuration;
+        const Configuration& q1 = plan.stances[fd.to].configuration;
+        for (int e : freeLimbEnds(fd))
+          if (auto l = plannedLimbJoints(q0, q1, sc_.robot->spotLimbRootJoint(e))) limbs.push_back(std::move(*l));
+        if (limbs.empty()) break;
+      }
       at.pieces.clear();
-      out.ok = solveFixed(plan, d, follow, wide, at);
+      out.ok = solveFixed(plan, fd, follow, wide, planned ? limbs : std::vector<LimbJointPath>{}, at);
       out.repaired = out.ok && attempt > 0;
       if (!out.ok && !at.cancelled) {
         const char* what[] = {"", "each knot near its neighbour too: ", "with more clearance: ",
-                              "with more clearance, each knot near its neighbour: "};
-        reasons += (attempt ? "; " : "") + std::string(what[attempt]) + at.reason;
+                              "with more clearance, each knot near its neighbour: ", "with the free limbs' joints planned: ",
+                              "with the free limbs' joints planned, each knot near its neighbour: "};
+        reasons += (reasons.empty() ? "" : "; ") + std::string(what[attempt]) + at.reason;
       }
     }
     if (!out.ok && !at.cancelled) at.reason = reasons;
@@ -345,8 +397,16 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     // a free foot that the witnesses' interpolation swings into the other
     // foot or a chair's leg.
     if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths) {
-      const std::vector<FreeEnd> free = freeEnds(plan, d);
+      const std::vector<FreeEnd> free = freeEnds(plan, d, false);
       if (!free.empty()) out.ok = tryPaths(&free, "with the free limbs on their own paths, ");
+    }
+    // Last, with the joints of each free limb that their interpolation
+    // sweeps through an obstacle planned (an elbow through a table's edge,
+    // which no path of the hand alone keeps clear).
+    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths && opt_.limb_joint_paths) {
+      const std::vector<FreeEnd> free = freeEnds(plan, d, true);
+      const bool planned_joints = std::any_of(free.begin(), free.end(), [](const FreeEnd& f) { return f.joints.has_value(); });
+      if (planned_joints) out.ok = tryPaths(&free, "with the free limbs' joints planned, ");
     }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
@@ -361,7 +421,27 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   return out;
 }
 
-bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide, Attempt& at) {
+std::optional<TransitionDesign> TransitionSolver::stillBody(const Plan& plan, const TransitionDesign& d) {
+  if (d.kind != TransitionDesign::Kind::Move || d.leave.has_value() == d.arrive.has_value()) return std::nullopt;
+  kin_.setConfiguration(plan.stances[d.from].configuration);
+  const Eigen::Isometry3d a = kin_.spotPose(d.spot);
+  kin_.setConfiguration(plan.stances[d.to].configuration);
+  const Eigen::Isometry3d b = kin_.spotPose(d.spot);
+  // Within the contract's contact tolerances of each other (1 mm, 1 degree).
+  if ((a.translation() - b.translation()).norm() > 1e-3 ||
+      Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() > M_PI / 180)
+    return std::nullopt;
+  TransitionDesign f = d;
+  f.kind = TransitionDesign::Kind::Fixed;
+  f.motion_stance = d.arrive ? d.to : d.from;
+  f.motion_contacts = plan.stances[f.motion_stance].specs();
+  for (auto& c : f.motion_contacts)
+    if (c.spot == d.spot) c.supporting = false;
+  return f;
+}
+
+bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide,
+                                  const std::vector<LimbJointPath>& limbs, Attempt& at) {
   PostureGenerator& generator = wide ? *wide_generator_ : generator_;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
@@ -375,7 +455,8 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
     PostureRequest r;
     r.contacts = d.motion_contacts;
     r.initial_guess = guess;
-    const Configuration ref = lerp(q0, q1, alpha);
+    Configuration ref = lerp(q0, q1, alpha);
+    for (const auto& l : limbs) ref = l.apply(ref, alpha);
     r.cost = std::make_shared<ReferencePostureCost>(follow ? lerp(guess, ref, 0.5) : ref);
     PostureResult res = generator.solve(r);
     ++at.posture_calls;
@@ -419,10 +500,6 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   return true;
 }
 
-struct TransitionSolver::FreeEnd {
-  int spot;
-  BodyPath path;
-};
 
 // The free limbs (no contact on them, and not the moving body's): each one's
 // end (its most distal spot: a foot, a palm) on a path of its own from where
@@ -431,23 +508,12 @@ struct TransitionSolver::FreeEnd {
 // beside the other foot to behind it). Left to the witnesses' interpolation
 // alone, in joint space, it can swing into an obstacle, slide along it from
 // knot to knot, and jump past it.
-std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& plan, const TransitionDesign& d) {
+std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& plan, const TransitionDesign& d,
+                                                                  bool plan_joints) {
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   const RobotModel& m = *sc_.robot;
-  auto depth = [&](int spot) { return m.ancestorJoints(m.spots()[spot].link).size(); };
-  std::vector<int> ends;  // per free limb, its most distal spot
-  for (int i = 0; i < static_cast<int>(m.spots().size()); ++i) {
-    const int root = m.spotLimbRootJoint(i);
-    bool held = root < 0 || root == m.spotLimbRootJoint(d.spot);
-    for (const auto& c : d.motion_contacts) held = held || m.spotLimbRootJoint(c.spot) == root;
-    if (held) continue;
-    const auto same = std::find_if(ends.begin(), ends.end(), [&](int e) { return m.spotLimbRootJoint(e) == root; });
-    if (same == ends.end())
-      ends.push_back(i);
-    else if (depth(i) > depth(*same))
-      *same = i;
-  }
+  const std::vector<int> ends = freeLimbEnds(d);
   std::vector<FreeEnd> out;
   const BodyPathPlanOptions po;
   for (int e : ends) {
@@ -462,9 +528,52 @@ std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& pl
       BodyPathPlan planned = planBodyPath(path, m, *sc_.scene, e, others, po);
       if (planned.path) path = std::move(*planned.path);
     }
-    out.push_back({e, std::move(path)});
+    out.push_back({e, std::move(path), plan_joints ? plannedLimbJoints(q0, q1, m.spotLimbRootJoint(e)) : std::nullopt});
+  }
+  // The joints beyond the moving body in its own limb (a hand beyond a
+  // forearm that leaves the table), which its path does not hold: planned
+  // the same way where their interpolation sweeps them into an obstacle.
+  if (plan_joints && d.spot >= 0) {
+    const int link = m.spots()[d.spot].link;
+    for (const auto& j : m.joints()) {
+      if (j.parent_link != link) continue;
+      if (auto l = plannedLimbJoints(q0, q1, j.index)) {
+        const BodyPathEnd here{kin_.spotPose(d.spot), std::nullopt};
+        out.push_back({d.spot, BodyPath(here, here, 0), std::move(l)});
+      }
+    }
   }
   return out;
+}
+
+std::vector<int> TransitionSolver::freeLimbEnds(const TransitionDesign& d) const {
+  const RobotModel& m = *sc_.robot;
+  auto depth = [&](int spot) { return m.ancestorJoints(m.spots()[spot].link).size(); };
+  std::vector<int> ends;  // per free limb, its most distal spot
+  for (int i = 0; i < static_cast<int>(m.spots().size()); ++i) {
+    const int root = m.spotLimbRootJoint(i);
+    bool held = root < 0 || (d.spot >= 0 && root == m.spotLimbRootJoint(d.spot));
+    for (const auto& c : d.motion_contacts) held = held || m.spotLimbRootJoint(c.spot) == root;
+    if (held) continue;
+    const auto same = std::find_if(ends.begin(), ends.end(), [&](int e) { return m.spotLimbRootJoint(e) == root; });
+    if (same == ends.end())
+      ends.push_back(i);
+    else if (depth(i) > depth(*same))
+      *same = i;
+  }
+  return ends;
+}
+
+// The joints themselves, where their interpolation sweeps the limb (an
+// elbow, not only the end) into an obstacle or another link (within half
+// the planner's clearance: the posture generator's margin is kept by knots
+// that hug an obstacle, and the interpolation between them dips below it).
+std::optional<LimbJointPath> TransitionSolver::plannedLimbJoints(const Configuration& q0, const Configuration& q1,
+                                                                 int root) {
+  const LimbPathPlanOptions lo;
+  if (limbSweepClearance(collisions_, kin_, root, q0, q1, lo.clearance) >= 0.5 * lo.clearance) return std::nullopt;
+  LimbPathPlan planned = planLimbPath(collisions_, kin_, root, q0, q1, lo);
+  return std::move(planned.path);
 }
 
 std::vector<PlacedShape> TransitionSolver::outsideLimb(const Configuration& q, int spot) {
@@ -493,14 +602,19 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
       at.reason = "cancelled";
       return std::nullopt;
     }
-    const Configuration ref = lerp(q0, q1, s);
+    Configuration ref = lerp(q0, q1, s);
     // Cost: the squared distance to the witnesses' interpolation plus the
     // squared distance to the neighbouring knot (the guess), i.e. the distance
     // to their midpoint: the knots stay on one branch of the body's inverse
     // kinematics instead of jumping between them.
     std::vector<ReferencePostureCost::SpotTarget> free_targets;
     if (free_ends)
-      for (const auto& f : *free_ends) free_targets.push_back({f.spot, f.path.pose(s).translation(), opt_.free_limb_weight});
+      for (const auto& f : *free_ends) {
+        if (f.joints)
+          ref = f.joints->apply(ref, s);
+        else
+          free_targets.push_back({f.spot, f.path.pose(s).translation(), opt_.free_limb_weight});
+      }
     const auto cost = std::make_shared<ReferencePostureCost>(lerp(guess, ref, 0.5), 1.0, 10.0, 1.0, free_targets);
     auto attempt = [&](const PoseTarget& t, const Configuration& g) {
       PostureRequest r;

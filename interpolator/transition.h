@@ -38,7 +38,11 @@
 // (body_path_planner.h), its orientation followed closely; then all of these
 // again with the end of each free limb (a foot or a hand with no contact)
 // pulled along a path of its own between its witness positions, where the
-// witnesses' interpolation swings it into an obstacle.
+// witnesses' interpolation swings it into an obstacle, or, where the limb's
+// interpolated joints sweep it through one (an elbow through a table's edge),
+// with those joints planned with OMPL (limb_path_planner.h). A Move whose
+// body touches its surface in both witnesses is solved as a Fixed one that
+// holds it there.
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -47,6 +51,7 @@
 
 #include "interpolator/body_path.h"
 #include "interpolator/body_path_planner.h"
+#include "interpolator/limb_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/check/validity.h"
 #include "planner/plan/plan.h"
@@ -98,6 +103,10 @@ struct TransitionOptions {
   // Then the same attempts with the end of each free limb (no contact on it)
   // pulled along a path of its own, with this weight (ReferencePostureCost::SpotTarget).
   bool free_limb_paths = true;
+  // There, a free limb whose joints' interpolation sweeps it through an
+  // obstacle has its joints planned with the transition's progress
+  // (limb_path_planner.h) and the knots follow them instead of its end's path.
+  bool limb_joint_paths = true;
   double free_limb_weight = 100;
   // A fixed-contact transition whose knots cannot be made valid at the
   // posture generator's collision margin is solved once more with this much
@@ -137,14 +146,26 @@ class TransitionSolver {
   struct Attempt;
   // `follow`: the cost also holds each knot near the previous one; `wide`:
   // the knots solved with the margin plus wide_clearance.
-  bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide, Attempt& at);
+  // `limbs`: free limbs' joints planned around what their interpolation sweeps them through (none: empty).
+  bool solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide,
+                  const std::vector<LimbJointPath>& limbs, Attempt& at);
   // `orientation_tolerance`: the body's orientation off its path's in the air (PoseTarget).
   struct FreeEnd;
   // `free_ends`: the end of each limb without contacts pulled along a path
   // of its own between its witness positions (none: nullptr).
   bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, double orientation_tolerance,
                  const std::vector<FreeEnd>* free_ends, Attempt& at);
-  std::vector<FreeEnd> freeEnds(const Plan& plan, const TransitionDesign& d);
+  // `plan_joints`: also the joints of each limb that their interpolation sweeps into an obstacle.
+  std::vector<FreeEnd> freeEnds(const Plan& plan, const TransitionDesign& d, bool plan_joints);
+  // Per limb with no contact in the transition (and not the moving body's), its most distal spot.
+  std::vector<int> freeLimbEnds(const TransitionDesign& d) const;
+  // The joints `root` moves (a limb, or what lies beyond the moving body in
+  // its limb) planned from q0's to q1's where their interpolation sweeps
+  // them into an obstacle; none where it does not, or no path was found.
+  std::optional<LimbJointPath> plannedLimbJoints(const Configuration& q0, const Configuration& q1, int root);
+  // A Move whose body already touches its surface in both witnesses, as the
+  // Fixed transition that holds it touching; none for any other.
+  std::optional<TransitionDesign> stillBody(const Plan& plan, const TransitionDesign& d);
   // The shapes of the links outside `spot`'s limb at q (all but its link, for a spot on the trunk).
   std::vector<PlacedShape> outsideLimb(const Configuration& q, int spot);
 
@@ -154,6 +175,7 @@ class TransitionSolver {
   std::optional<PostureGenerator> wide_generator_;  // collision margin + wide_clearance, if that is positive
   ValidityChecker checker_;
   Kinematics kin_;
+  CollisionModel collisions_;  // the free limbs' joint paths (limb_path_planner.h)
 };
 
 }  // namespace acyclic

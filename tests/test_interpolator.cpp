@@ -13,6 +13,7 @@
 #include "interpolator/body_path.h"
 #include "interpolator/body_path_planner.h"
 #include "interpolator/interpolator.h"
+#include "interpolator/limb_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/check/trajectory_check.h"
 #include "test_support.h"
@@ -287,6 +288,77 @@ TEST(BodyPathPlanner, PlansAFootOverABoxClearOfItTheSameEachTime) {
   const BodyPathPlan none = planBodyPath(designed, *sc.robot, *sc.scene, r, held, o);
   EXPECT_FALSE(none.path);
   EXPECT_NE(none.reason.find("no path"), std::string::npos) << none.reason;
+}
+
+TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEachTime) {
+  // From a plan of the chair with its OMPL guide: on the left foot, the
+  // right foot stepping, the free left hand goes from hanging in front of the
+  // table's edge, below its top, to resting over the top. Its joints'
+  // interpolation sweeps the forearm through the edge; the planned path,
+  // with the body on the witnesses' interpolation at its progress, clears it.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  const Configuration& q0 = plan.stances[0].configuration;
+  const Configuration& q1 = plan.stances[1].configuration;
+  const CollisionModel collisions(sc.robot, sc.scene);
+  Kinematics kin(sc.robot);
+  const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_palm"));
+  const std::vector<int> joints = limbJoints(*sc.robot, root);
+  ASSERT_EQ(joints.size(), 7u);  // LARM_JOINT0..6
+  EXPECT_EQ(sc.robot->joints()[joints.front()].name, "LARM_JOINT0");
+  EXPECT_LT(limbSweepClearance(collisions, kin, root, q0, q1, 0.01), -0.05);
+  const LimbPathPlan p = planLimbPath(collisions, kin, root, q0, q1);
+  ASSERT_TRUE(p.path) << p.reason;
+  const LimbJointPath& path = *p.path;
+  EXPECT_GT(path.waypoints().size(), 2u);  // not the straight line
+  // Its ends are the witnesses'; its progress increases from 0 to 1.
+  EXPECT_EQ(path.apply(q0, 0).joints, q0.joints);
+  EXPECT_EQ(path.apply(q1, 1).joints, q1.joints);
+  for (std::size_t i = 1; i < path.params().size(); ++i) EXPECT_GT(path.params()[i], path.params()[i - 1]) << i;
+  // Along it, the arm clears the table and the body, where the body is at that progress.
+  ValidityChecker checker(sc.robot, sc.scene);
+  double worst = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= 200; ++i) {
+    const double s = i / 200.0;
+    kin.setConfiguration(path.apply(lerp(q0, q1, s), s));
+    for (const auto& d : collisions.distances(kin))
+      if (sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_a) !=
+          (collisions.pairs()[d.pair].kind == CollisionPair::Kind::Self &&
+           sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_b)))
+        worst = std::min(worst, d.distance);
+  }
+  EXPECT_GT(worst, 0.0);
+  // Seeded: the same path again.
+  const LimbPathPlan again = planLimbPath(collisions, kin, root, q0, q1);
+  ASSERT_TRUE(again.path);
+  ASSERT_EQ(again.path->waypoints().size(), path.waypoints().size());
+  for (std::size_t i = 0; i < path.waypoints().size(); ++i) EXPECT_EQ(again.path->waypoints()[i], path.waypoints()[i]) << i;
+  // With no budget, no path, and the reason says so.
+  LimbPathPlanOptions none;
+  none.max_checks = 1;
+  const LimbPathPlan n = planLimbPath(collisions, kin, root, q0, q1, none);
+  EXPECT_FALSE(n.path);
+  EXPECT_NE(n.reason.find("no path"), std::string::npos) << n.reason;
+}
+
+TEST(LimbJointPath, InterpolatesBetweenWaypointsAtTheirProgress) {
+  const LimbJointPath p({3, 5}, {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 2)}, {0, 0.25, 1});
+  EXPECT_TRUE(p.at(-1).isApprox(Eigen::Vector2d(0, 0)));
+  EXPECT_TRUE(p.at(0.125).isApprox(Eigen::Vector2d(0.5, 0)));
+  EXPECT_TRUE(p.at(0.625).isApprox(Eigen::Vector2d(1, 1)));
+  EXPECT_TRUE(p.at(2).isApprox(Eigen::Vector2d(1, 2)));
+  // Without parameters, by joint-space length: 1 then 2.
+  const LimbJointPath q({3, 5}, {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 2)});
+  EXPECT_NEAR(q.params()[1], 1.0 / 3.0, 1e-12);
+  Configuration c;
+  c.joints = Eigen::VectorXd::Zero(6);
+  const Configuration d = p.apply(c, 1);
+  EXPECT_EQ(d.joints[3], 1);
+  EXPECT_EQ(d.joints[5], 2);
+  EXPECT_EQ(d.joints[4], 0);
+  EXPECT_THROW(LimbJointPath({0}, {}), std::invalid_argument);
+  EXPECT_THROW(LimbJointPath({0}, {Eigen::VectorXd::Zero(1)}, {0, 1}), std::invalid_argument);
 }
 
 // --- The time law -----------------------------------------------------------
@@ -703,6 +775,53 @@ TEST(Interpolator, FreeFootKeepsToAPathOfItsOwnWhileTheHandReachesTheTable) {
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_reach.plan.json"), sc);
   ASSERT_EQ(plan.stances.size(), 2u);
   expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.free_limb_paths = false; }, "stances 0 -> 1");
+}
+
+TEST(Interpolator, FreeArmGoesOverTheTableEdgeOnPlannedJoints) {
+  // tests/data/chair_ompl_arm_over_edge.plan.json (LimbPathPlanner's test):
+  // the right foot steps while the free left hand goes from below the table
+  // top's level, in front of its edge, to over the top. With its end on a
+  // path of its own, the elbow still cuts the edge; with the arm's joints
+  // planned with the transition's progress, every sample is valid.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.limb_joint_paths = false; }, "stances 0 -> 1");
+}
+
+TEST(Interpolator, WeightShiftWithTheFreeArmBroughtBackOverTheTableEdge) {
+  // From a chair plan made with stability margins: on both feet, the weight
+  // goes to the right foot while the free right hand comes back from above
+  // the table top, over its edge, to hang in front of it. Its joints'
+  // interpolation drags the fingers through the edge, by less than a
+  // millimetre at the knots' margin, however refined and with more
+  // clearance; on the arm's joints planned around the edge, every sample is valid.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_margins_arm_off_table.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.limb_joint_paths = false; }, "stances 0 -> 1",
+                         InterpolationResult::Status::TransitionFailed);
+}
+
+TEST(Interpolator, WristLaidBesideTheForearmOnTheTableDoesNotMove) {
+  // From the same plan: the right forearm on the table, the right wrist is
+  // added where the witness already has it touching the table. No path of
+  // zero length for the posture generator to follow: the contact is held
+  // touching while the body shifts, as a support flip; the wrist stays put.
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_wrist_beside_forearm.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  expectValid(r.trajectory, sc);
+  const int wrist = sc.robot->spotIndex("r_wrist");
+  const Eigen::Vector3d at = spotAt(sc, plan.stances[1].configuration, wrist).translation();
+  double drift = 0;
+  for (const auto& sample : r.trajectory.samples)
+    drift = std::max(drift, (spotAt(sc, sample.q, wrist).translation() - at).norm());
+  EXPECT_LT(drift, 1e-3);
 }
 
 TEST(Interpolator, BadInputAndCancellation) {
