@@ -3,6 +3,8 @@
 // independent check (the exit status says so) and it names bad input.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "test_support.h"
 
 namespace {
@@ -34,6 +36,41 @@ TEST(AcyclicPosture, BothThighsOffWithFeetAloneIsFoundAndValid) {
   const auto r = probe("--remove r_thigh --remove l_thigh --iterations 100");
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("[ ok ] equilibrium   2 supporting contacts"), std::string::npos) << r.output;
+}
+
+TEST(AcyclicPosture, AKneeRestsOnTheFloorWhereALevelShankCannot) {
+  // Standing on open floor: the weight to the left foot, then the right knee
+  // on the floor. HRP-2's knee pad is the rounded front of the knee, 20
+  // degrees up from straight ahead (models/hrp2/hrp2.yaml): the shank rises
+  // from the floor and the foot clears it. With a pad straight ahead of the
+  // shank (the model of tests/data/hrp2_midthigh.yaml), the shank would lie
+  // level and the ankle's range leaves the foot in the floor: no posture.
+  acyclic::test::TempDir dir;
+  const std::string bin = acyclic::test::binaryPath("processes/acyclic-posture") + " ";
+  const std::string standing = acyclic::test::sourcePath("models/scenarios/step_forward.yaml");
+  const auto shift = acyclic::test::runProcess(bin + standing + " --remove r_sole --out " + dir.path() + "/a.json");
+  ASSERT_EQ(shift.status, 0) << shift.output;
+  const auto kneel = acyclic::test::runProcess(bin + standing + " --from " + dir.path() + "/a.json --add r_knee@floor");
+  EXPECT_EQ(kneel.status, 0) << kneel.output;
+  EXPECT_NE(kneel.output.find("[ ok ] collisions"), std::string::npos) << kneel.output;
+  EXPECT_NE(kneel.output.find("[ ok ] equilibrium"), std::string::npos) << kneel.output;
+  // The same two calls with the level pad.
+  const std::string level = dir.path() + "/level.yaml";
+  {
+    std::ofstream f(level);
+    f << "format: acyclic.scenario/1\nname: level_knee\n"
+      << "robot: " << acyclic::test::sourcePath("tests/data/hrp2_midthigh.yaml") << "\n"
+      << "scene: " << acyclic::test::sourcePath("models/scenes/open_floor.yaml") << "\n"
+      << "start:\n  configuration: {posture: half_sitting}\n  contacts:\n"
+      << "    - {spot: r_sole, surface: floor}\n    - {spot: l_sole, surface: floor}\n"
+      << "allowed_spots: [r_sole, l_sole, r_knee]\nallowed_surfaces: [floor]\n"
+      << "goal: {link: WAIST, axis: x, min: 0.25}\n";
+  }
+  const auto level_shift = acyclic::test::runProcess(bin + level + " --remove r_sole --out " + dir.path() + "/b.json");
+  ASSERT_EQ(level_shift.status, 0) << level_shift.output;
+  const auto level_kneel =
+      acyclic::test::runProcess(bin + level + " --from " + dir.path() + "/b.json --add r_knee@floor --iterations 1000");
+  EXPECT_EQ(level_kneel.status, 1) << level_kneel.output;
 }
 
 TEST(AcyclicPosture, BadInputIsNamedAndExitsTwo) {
