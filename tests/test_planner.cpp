@@ -147,6 +147,27 @@ TEST(ContactPlanner, SitDownIsPlannedWithBothThighsOnTheSeat) {
 // Two posture generators solve a pair's candidates two at a time, and an
 // expansion's calls as one batch; the search takes their results in the
 // order of solving them one by one: the same tree, the same plan.
+TEST(ContactPlanner, ThePapersChairCannotBeLeftOnTheFeetAlone) {
+  // models/scenarios/chair_paper.yaml: the table overhangs the thighs, so
+  // the trunk cannot lean far enough to bring the centre of mass over the
+  // feet. Restricted to the soles and thighs, the search runs out of stances
+  // (every one reachable from the start explored, none with both thighs off
+  // the seat) long before its budgets: no solution, not an exhausted budget.
+  test::TempDir dir;
+  std::string text = test::scenarioText("models/scenarios/chair_paper.yaml");
+  const std::string spots = "allowed_spots: [r_sole, l_sole, r_knee, l_knee, r_thigh, l_thigh,\n"
+                            "                r_forearm, l_forearm, r_wrist, l_wrist, r_palm, l_palm]";
+  ASSERT_NE(text.find(spots), std::string::npos);
+  text.replace(text.find(spots), spots.size(), "allowed_spots: [r_sole, l_sole, r_thigh, l_thigh]");
+  const Scenario sc = Scenario::load(dir.write("feet_only.yaml", text));
+  PlannerParameters params = plannerParameters(sc);
+  params.max_seconds = 600;  // budgets far beyond what the search needs
+  ContactPlanner planner(sc, params);
+  const PlanningResult r = planner.plan();
+  EXPECT_EQ(r.status, PlanningResult::Status::NoSolution) << toString(r.status) << ": " << r.reason;
+  EXPECT_LT(r.stats.nodes_generated, 3000);  // the scenario's node budget, far from reached
+}
+
 TEST(ContactPlanner, CallsSolvedAheadLeaveTheTreeAsItWas) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
   PlannerParameters one = plannerParameters(sc), two = one;

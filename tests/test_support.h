@@ -67,8 +67,9 @@ inline ProcessRun runProcess(const std::string& command) {
 inline std::string scenarioText(const std::string& rel) {
   std::string text = readFile(sourcePath(rel));
   const std::string models = sourcePath("models/");
-  text.replace(text.find("../hrp2/"), 8, models + "hrp2/");
-  text.replace(text.find("../scenes/"), 10, models + "scenes/");
+  // The fields, not a comment that names the same files.
+  text.replace(text.find("\nrobot: ../hrp2/") + 8, 8, models + "hrp2/");
+  text.replace(text.find("\nscene: ../scenes/") + 8, 10, models + "scenes/");
   return text;
 }
 
