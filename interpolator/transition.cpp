@@ -40,6 +40,16 @@ std::vector<ContactSpec> missingFrom(const std::vector<ContactSpec>& a, const st
 // worst, inside the contract's 1 mm and 1 degree.
 constexpr double kTouchMargin = 5e-5, kTouchAcross = 3e-4, kTouchAlong = 1e-4, kTouchTilt = 0.01;
 
+// A body hanging from a contact of its own limb (a foot whose thigh rests on
+// a seat) swings on an arc about the held link: it cannot rise straight off
+// its surface, it scuffs along it first (about 5.7 times as far as it rises,
+// a shank 10 degrees from vertical). It changes phase when it is
+// kPendulumTouch off the surface, within kPendulumAcross of the touch point
+// (0.86 mm at worst, inside the contract's 1 mm), and in between the knots
+// follow the witnesses' interpolation with its position free, clear of the
+// surface.
+constexpr double kPendulumTouch = 1.5e-4, kPendulumAcross = 8.5e-4;
+
 std::string pair(int a, int b) { return "stances " + std::to_string(a) + " -> " + std::to_string(b); }
 
 double distance(const Configuration& a, const Configuration& b) {
@@ -321,6 +331,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     };
     const double h = d.leave && !d.arrive ? heightOver(e0, e1) : d.arrive && !d.leave ? heightOver(e1, e0) : -1;
     if (h > 0 && h < lift) lift = std::max(h, 2 * opt_.touch_clearance);
+    if (hangsFromItsLimb(d)) lift = 2 * kPendulumTouch;
     const BodyPath path(e0, e1, lift);
     // The links held on their contacts during the motion, where the first witness has them.
     std::vector<PlacedShape> held;
@@ -419,6 +430,20 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   out.pieces = std::move(at.pieces);
   if (!out.ok) out.pieces.clear();
   return out;
+}
+
+bool TransitionSolver::hangsFromItsLimb(const TransitionDesign& d) const {
+  if (d.kind != TransitionDesign::Kind::Move || d.spot < 0) return false;
+  const RobotModel& m = *sc_.robot;
+  const int link = m.spots()[d.spot].link;
+  for (const auto& c : d.motion_contacts) {
+    const int held = m.spots()[c.spot].link;
+    if (held == link) continue;
+    // The held link is an ancestor of the moving one: a joint below it moves the body.
+    for (const auto& j : m.joints())
+      if (j.parent_link == held && m.jointMovesLink(j.index, link)) return true;
+  }
+  return false;
 }
 
 std::optional<TransitionDesign> TransitionSolver::stillBody(const Plan& plan, const TransitionDesign& d) {
@@ -594,7 +619,9 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
   std::vector<int> touch;
   if (d.leave) touch.push_back(sc_.scene->surfaces()[d.leave->surface].obstacle);
   if (d.arrive) touch.push_back(sc_.scene->surfaces()[d.arrive->surface].obstacle);
-  const double s0 = path.leaveParameter(opt_.touch_clearance), s1 = path.arriveParameter(opt_.touch_clearance);
+  const bool pendulum = hangsFromItsLimb(d);
+  const double touch_clearance = pendulum ? kPendulumTouch : opt_.touch_clearance;
+  const double s0 = path.leaveParameter(touch_clearance), s1 = path.arriveParameter(touch_clearance);
   bool loose_only = false;
   auto solveAt = [&](double s, const Configuration& guess) -> std::optional<Configuration> {
     if (at.cancel && at.cancel->load()) {
@@ -632,7 +659,21 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     t.pose = path.pose(s);
     t.touch_obstacles = touch;
     std::vector<PoseTarget> targets;
-    if (!path.straightAt(s)) {  // in the air
+    if (pendulum) {
+      // Hanging from its limb's contact: where the contact changes, near the
+      // touch point; elsewhere anywhere clear of the surface, the cost
+      // (the witnesses' interpolation) swinging it on its arc.
+      PoseTarget swing = t;
+      swing.touch_margin = kTouchMargin;
+      if ((d.leave && s == s0) || (d.arrive && s == s1)) {
+        swing.position_tolerance = Eigen::Vector3d(kPendulumAcross, kPendulumAcross, kTouchAlong);
+        swing.orientation_tolerance = kTouchTilt;
+      } else {
+        swing.position_tolerance.setConstant(10.0);
+        swing.orientation_tolerance = 0.99;  // the widest a pose target takes: free within 80 degrees
+      }
+      targets.push_back(swing);
+    } else if (!path.straightAt(s)) {  // in the air
       t.orientation_tolerance = orientation_tolerance;
       targets.push_back(t);
       // Failing that, within straight_slack of it: a body that had to pivot

@@ -166,6 +166,9 @@ class TransitionSolver {
   // A Move whose body already touches its surface in both witnesses, as the
   // Fixed transition that holds it touching; none for any other.
   std::optional<TransitionDesign> stillBody(const Plan& plan, const TransitionDesign& d);
+  // Whether the Move's body hangs from a contact of its own limb (a foot
+  // whose thigh rests on the seat): it swings on an arc (transition.cpp).
+  bool hangsFromItsLimb(const TransitionDesign& d) const;
   // The shapes of the links outside `spot`'s limb at q (all but its link, for a spot on the trunk).
   std::vector<PlacedShape> outsideLimb(const Configuration& q, int spot);
 

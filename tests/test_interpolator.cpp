@@ -35,6 +35,11 @@ const Scenario& chairScenario() {
   return sc;
 }
 
+const Scenario& paperChairScenario() {
+  static Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
+  return sc;
+}
+
 // The chair scene as it was before its seat was lowered (seat at knee-pit
 // height, thigh spots mid-thigh), kept for the fixture plan made in it.
 const Scenario& kneePitChairScenario() {
@@ -822,6 +827,29 @@ TEST(Interpolator, WristLaidBesideTheForearmOnTheTableDoesNotMove) {
   for (const auto& sample : r.trajectory.samples)
     drift = std::max(drift, (spotAt(sc, sample.q, wrist).translation() - at).norm());
   EXPECT_LT(drift, 1e-3);
+}
+
+TEST(Interpolator, AFootHangingFromItsThighOnTheSeatSwingsDownToTheFloor) {
+  // From a plan of the paper's chair (tests/data/chair_paper_foot_from_thigh.plan.json):
+  // seated on the left thigh, the right foot on the floor and the right
+  // wrist on the table, the free left foot comes down to the floor. Its leg
+  // is held at the thigh: the foot swings on an arc about the knee and
+  // cannot come straight down along the floor's normal; it reaches the
+  // floor scuffing less than a millimetre, every sample valid.
+  const Scenario& sc = paperChairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_paper_foot_from_thigh.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  expectValid(r.trajectory, sc);
+  // The last phase holds the foot's contact: within 1 mm of its placement from its first sample.
+  const int foot = sc.robot->spotIndex("l_sole");
+  const Eigen::Vector3d at = spotAt(sc, plan.stances[1].configuration, foot).translation();
+  const int last = r.trajectory.samples.back().phase;
+  for (const auto& sample : r.trajectory.samples)
+    if (sample.phase == last) EXPECT_LT((spotAt(sc, sample.q, foot).translation() - at).norm(), 1e-3);
 }
 
 TEST(Interpolator, BadInputAndCancellation) {
