@@ -152,6 +152,36 @@ TEST(GuideAuthor, ACrouchOnTheFeetEndsLoweredOnTheStartStance) {
   EXPECT_TRUE(checker.checkPosture(r.guide.key_postures.back(), feet).valid());
 }
 
+TEST(GuideAuthor, AGoalBeyondAStepsEdgeEndsStandingOnTheStep) {
+  // tests/data/step_up_scene.yaml: a platform 0.15 m high, its edge 0.35 m
+  // ahead; the goal is the waist 0.75 m ahead, over the platform. Standing on
+  // the floor there puts the feet inside the platform: the guide ends
+  // standing on its top, both feet on it, a stance the check accepts.
+  test::TempDir dir;
+  const std::string text = "format: acyclic.scenario/1\nname: step_up\nrobot: " +
+                           test::sourcePath("models/hrp2/hrp2.yaml") + "\nscene: " +
+                           test::sourcePath("tests/data/step_up_scene.yaml") +
+                           "\nstart:\n  configuration: {posture: half_sitting}\n  contacts:\n"
+                           "    - {spot: r_sole, surface: floor}\n    - {spot: l_sole, surface: floor}\n"
+                           "allowed_spots: [r_sole, l_sole, r_palm]\nallowed_surfaces: [floor, platform_top, wall_face]\n"
+                           "goal: {link: WAIST, axis: x, min: 0.75}\n";
+  const Scenario sc = Scenario::load(dir.write("step_up.yaml", text));
+  GuideResult r;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, r));
+  const Configuration& end = r.guide.key_postures.back();
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(end);
+  EXPECT_TRUE(sc.goal.linkWithinBounds(kin));
+  std::vector<ContactSpec> feet(2);
+  feet[0].spot = sc.robot->spotIndex("r_sole");
+  feet[1].spot = sc.robot->spotIndex("l_sole");
+  feet[0].surface = feet[1].surface = sc.scene->surfaceIndex("platform_top");
+  placeOnSurfaces(sc, kin, feet);
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checker.checkPosture(end, feet).valid());
+  EXPECT_NEAR(end.base_position.z(), sc.robot->posture("half_sitting").base_position.z() + 0.15, 0.05);
+}
+
 TEST(GuideAuthor, AHeightGoalWithoutSupportsIsRefusedWithTheReason) {
   std::string text = test::scenarioText("models/scenarios/sit_down.yaml");
   const std::string supports = ", supported_by: [r_thigh, l_thigh]";

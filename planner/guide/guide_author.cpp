@@ -211,12 +211,16 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
 }
 
 // A posture in the goal region. First standing: the named standing posture
-// moved there, feet put on the start's floor surface. Failing that (a robot
+// moved there, feet put on the start's floor surface or on a level surface
+// above it (standingSurfaces). Failing that (a robot
 // that cannot stand on its feet alone there, as on the wet ramp), the start
 // stance carried there: the start posture moved along the goal's axis, each
 // start contact put on its surface where the moved posture holds its spot.
 // Each through the posture generator and the independent check, the free
 // horizontal coordinate tried around the start's, nearest first.
+// A surface whose outward normal is within 10 degrees of straight up: one to stand on.
+constexpr double kLevelSurface = 0.985;
+
 bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, std::string& why) {
   const RobotModel& m = *sc.robot;
   if (!m.postures().count(o.standing_posture)) {
@@ -258,14 +262,38 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
   const Eigen::Vector3d standing_offset = kin.linkPose(g.link).translation() - standing.base_position;
   kin.setConfiguration(sc.start);
   const Eigen::Vector3d start_offset = kin.linkPose(g.link).translation() - sc.start.base_position;
+  // Where to stand: the start's floor, or a level surface the scenario
+  // allows (a platform, a step) under both feet, the highest first: a goal
+  // beyond a step's edge is met standing on the step, not in it.
+  const double floor_height = sc.scene->surfaces()[floor].frame.translation().z();
+  auto standingSurfaces = [&](const Configuration& q) {
+    kin.setConfiguration(q);
+    std::vector<std::pair<double, int>> under;  // height, surface
+    for (int s : sc.allowed_surfaces) {
+      const Surface& surf = sc.scene->surfaces()[s];
+      if (s != floor && surf.frame.linear().col(2).z() < kLevelSurface) continue;
+      bool both = true;
+      for (int spot : {r_sole, l_sole}) {
+        const Eigen::Vector3d p = surf.frame.inverse() * kin.spotPose(spot).translation();
+        both = both && surf.polygon.contains(p.head<2>());
+      }
+      if (both) under.push_back({surf.frame.translation().z(), s});
+    }
+    std::sort(under.begin(), under.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    return under;
+  };
   std::vector<ContactSpec> feet(2);
   feet[0].spot = r_sole, feet[1].spot = l_sole;
-  feet[0].surface = feet[1].surface = floor;
   for (double off : offsets) {
     Configuration q = standing;
     q.base_position[g.axis] = bound - standing_offset[g.axis];
     q.base_position[free_axis] = sc.start.base_position[free_axis] + off;
-    if (solveGoalStance(sc, pg, checker, kin, q, feet, out)) return true;
+    for (const auto& [height, surface] : standingSurfaces(q)) {
+      Configuration raised = q;
+      raised.base_position.z() += height - floor_height;
+      feet[0].surface = feet[1].surface = surface;
+      if (solveGoalStance(sc, pg, checker, kin, raised, feet, out)) return true;
+    }
   }
   for (double off : offsets) {
     Configuration q = sc.start;
