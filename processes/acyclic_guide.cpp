@@ -17,8 +17,9 @@ using namespace acyclic;
 int main(int argc, char** argv) {
   CLI::App app{
       "Authors a scenario's rough trajectory with OMPL (the paper wrote it by hand): a posture in the goal\n"
-      "region from the posture generator (standing, on the floor or a level surface above it; else the start stance carried there; for a goal on a\n"
-      "link's height, resting on the goal's supported_by spots), then RRTConnect in (base position, heading, blend\n"
+      "region from the posture generator (standing, on the floor or a level surface above it; else the\n"
+      "start stance carried there; for a goal on a link's height, resting on the goal's supported_by\n"
+      "spots), then RRTConnect in (base position, heading, blend\n"
       "from the start posture to the goal posture) with FCL against the scene, the robot allowed to\n"
       "graze obstacles by --penetration; the path shortcut and lifted to whole-body key postures.\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
