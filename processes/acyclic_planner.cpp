@@ -51,6 +51,8 @@ int main(int argc, char** argv) {
   app.add_flag("--distance-to-goal", o.distance_to_goal, "ablation: distance to the goal instead of the guide potential");
   app.add_flag("--no-failure-memory", o.no_failure_memory,
                "ablation: try every pair at every node, even where it just failed from the same place");
+  app.add_flag("--no-swing-check", o.no_swing_check,
+               "ablation: accept sons whose limb hanging from a shared contact cannot swing to its new place");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)

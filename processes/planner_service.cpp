@@ -30,6 +30,7 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   p.optimized_candidates = !random_candidates;
   p.guide_potential = !distance_to_goal;
   if (no_failure_memory) p.failure_memory = false;
+  if (no_swing_check) p.swing_check = false;
   if (verbose) p.trace = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   return p;
 }

@@ -13,7 +13,7 @@ struct PlannerOverrides {
   double max_seconds = -1;
   long max_nodes = -1, max_posture_calls = -1;
   int threads = -1;
-  bool eager_sons = false, random_candidates = false, distance_to_goal = false, no_failure_memory = false;
+  bool eager_sons = false, random_candidates = false, distance_to_goal = false, no_failure_memory = false, no_swing_check = false;
   bool verbose = false;  // one line per expanded node on stderr
   // The scenario's parameters with these overrides; a request's time budget
   // (> 0) applies unless --max-seconds is given. Also sets sc.seed.

@@ -7,6 +7,7 @@
 #include "planner/check/plan_check.h"
 #include "planner/common/format_error.h"
 #include "planner/search/planner_parameters.h"
+#include "planner/search/swing_check.h"
 #include "test_support.h"
 
 using namespace acyclic;
@@ -168,6 +169,36 @@ TEST(ContactPlanner, ThePapersChairCannotBeLeftOnTheFeetAlone) {
   EXPECT_LT(r.stats.nodes_generated, 3000);  // the scenario's node budget, far from reached
 }
 
+TEST(SwingCheck, AFootHangingFromItsThighCannotSwingUnderTheKneeButComesDown) {
+  // From a plan of the paper's chair made before this check: seated on the
+  // left thigh, the right wrist on the table, the left foot goes from the
+  // floor behind the knee to the air in front of it. Below the thigh only the
+  // knee and ankle move: the foot swings under the knee, 0.40 m up, and
+  // through the floor. In the other pair the foot comes down in front of the
+  // knee without passing under it.
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
+  const CollisionModel collisions(sc.robot, sc.scene);
+  Kinematics kin(sc.robot);
+  auto held = [&](const Plan& p) {  // the contacts of both stances
+    std::vector<ContactSpec> out;
+    for (const auto& a : p.stances[0].specs())
+      for (const auto& b : p.stances[1].specs())
+        if (a.spot == b.spot && a.surface == b.surface && a.supporting && b.supporting) out.push_back(a);
+    return out;
+  };
+  const Plan under = readPlan(test::sourcePath("tests/data/chair_paper_foot_under_knee.plan.json"), sc);
+  const std::vector<ContactSpec> h = held(under);
+  ASSERT_EQ(h.size(), 2u);  // l_thigh, r_wrist
+  const std::string why =
+      checkHangingSwings(sc, collisions, kin, h, under.stances[0].configuration, under.stances[1].configuration);
+  EXPECT_NE(why.find("LLEG_LINK5/foot"), std::string::npos) << why;  // in the floor, or the other foot when the ankle turns
+  EXPECT_NE(why.find("l_thigh"), std::string::npos) << why;
+  const Plan down = readPlan(test::sourcePath("tests/data/chair_paper_foot_from_thigh.plan.json"), sc);
+  EXPECT_EQ(checkHangingSwings(sc, collisions, kin, held(down), down.stances[0].configuration,
+                               down.stances[1].configuration),
+            "");
+}
+
 TEST(ContactPlanner, CallsSolvedAheadLeaveTheTreeAsItWas) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
   PlannerParameters one = plannerParameters(sc), two = one;
@@ -275,7 +306,7 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
                                              "posture_stop_at_restoration: false, posture_mu_oracle: probing, "
                                              "posture_distance_engine: convex, posture_pyramid_edges: 8, "
                                              "posture_support_inset: 0.02, posture_friction_share: 0.8, "
-                                             "posture_support_inset_y: 0.03}\n"));
+                                             "posture_support_inset_y: 0.03, swing_check: false}\n"));
   const PlannerParameters p = plannerParameters(tuned);
   EXPECT_EQ(p.max_nodes, 77);
   EXPECT_DOUBLE_EQ(p.box.y, 0.2);
@@ -289,6 +320,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_TRUE(p.posture.lbfgs_in_kkt);
   EXPECT_FALSE(plannerParameters(plain).posture.lbfgs_in_kkt);  // the planner's default (contact_planner.cpp)
   EXPECT_TRUE(plannerParameters(plain).failure_memory);
+  EXPECT_FALSE(p.swing_check);
+  EXPECT_TRUE(plannerParameters(plain).swing_check);
   EXPECT_DOUBLE_EQ(p.alternative_step, 0.05);
   EXPECT_FALSE(p.posture.stop_at_restoration);
   EXPECT_TRUE(plannerParameters(plain).posture.stop_at_restoration);  // the planner's default

@@ -11,6 +11,8 @@
 #include <thread>
 
 #include "planner/check/validity.h"
+#include "planner/collision/collision_model.h"
+#include "planner/search/swing_check.h"
 #include "planner/search/guide_potential.h"
 
 namespace acyclic {
@@ -86,6 +88,7 @@ struct ContactPlanner::Impl {
   std::vector<std::unique_ptr<PostureGenerator>> pgs;  // one per thread
   ValidityChecker checker;
   Kinematics kin;  // the search is single-threaded: one for every key, goal and reach test
+  CollisionModel collisions;  // the hanging limbs' swings (swing_check.h)
   std::unique_ptr<GuidePotential> guide;
   std::mt19937 rng;
 
@@ -137,7 +140,8 @@ struct ContactPlanner::Impl {
   std::string stop_reason;
 
   Impl(const Scenario& s, PlannerParameters params)
-      : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), rng(s.seed) {
+      : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), collisions(s.robot, s.scene),
+        rng(s.seed) {
     for (int t = 0; t < std::max(1, p.threads); ++t)
       pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
     if (p.guide_potential) {
@@ -265,6 +269,22 @@ struct ContactPlanner::Impl {
     if (!checker.checkPosture(n.q, n.transition).valid()) {
       ++stats.check_refusals;
       return -1;
+    }
+    // A limb hanging from a contact both hold must swing from the parent's
+    // witness to this one clear of the obstacles (swing_check.h); counted
+    // with the check's refusals.
+    if (p.swing_check && n.parent >= 0) {
+      const Node& par = nodes[n.parent];
+      std::vector<ContactSpec> held;
+      for (const auto& c : par.contacts)
+        for (const auto& t : n.transition)
+          if (c.spot == t.spot && c.surface == t.surface && std::abs(c.placement.x - t.placement.x) <= 1e-9 &&
+              std::abs(c.placement.y - t.placement.y) <= 1e-9)
+            held.push_back(c);
+      if (!checkHangingSwings(sc, collisions, kin, held, par.q, n.q).empty()) {
+        ++stats.check_refusals;
+        return -1;
+      }
     }
     n.depth = n.parent >= 0 ? nodes[n.parent].depth + 1 : 0;
     if (!key_given) n.key = keyOf(n.q);  // leaves kin at n.q

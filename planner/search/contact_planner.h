@@ -62,6 +62,10 @@ struct PlannerParameters {
   // A son that adds or removes a contact on the spot's own limb (the foot of
   // the leg whose thigh failed) poses a new problem: the memory stops there.
   bool failure_memory = true;
+  // A son whose limb hanging from a contact it shares with its parent (a
+  // foot below a thigh on the seat) cannot swing from the parent's witness
+  // to its own clear of the obstacles is refused (swing_check.h).
+  bool swing_check = true;
   double failure_memory_distance = 0.05;  // m
   double failure_memory_angle = 0.35;     // rad
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically

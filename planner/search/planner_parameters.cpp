@@ -12,7 +12,8 @@ PlannerParameters plannerParameters(const Scenario& sc) {
                "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
                "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
                "posture_pyramid_edges", "posture_support_inset", "posture_support_inset_y", "posture_friction_share",
-               "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle"});
+               "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle",
+               "swing_check"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
     const double v = f[key].number();
@@ -42,6 +43,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   positive("failure_memory_distance", p.failure_memory_distance);
   positive("failure_memory_angle", p.failure_memory_angle);
   if (f.has("failure_memory")) p.failure_memory = f["failure_memory"].boolean();
+  if (f.has("swing_check")) p.swing_check = f["swing_check"].boolean();
   positive("max_seconds", p.max_seconds);
   positive("collision_margin", p.posture.problem.collision_margin);
   count("max_contacts", p.max_contacts);
