@@ -115,23 +115,15 @@ BodyPathPlan planBodyPath(const BodyPath& path, const RobotModel& robot, const S
   start[4] = 0;
   goal[4] = 1;
   ss.setStartAndGoalStates(start, goal);
-  auto planner = std::make_shared<SeededRRTConnect>(si, seed);
-  ss.setPlanner(planner);
-  ss.setup();
-  // Bounded by state checks, not time: the same path under any load.
-  const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition([&] { return checks >= o.max_checks; }));
-  if (st != ob::PlannerStatus::EXACT_SOLUTION) {
+  std::optional<og::PathGeometric> found = solveSeededRRTConnect(ss, seed, checks, o.max_checks);
+  if (!found) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "OMPL (RRTConnect) found no path for the body alone, %.0f mm clear, in %ld state checks",
                   o.clearance * 1e3, o.max_checks);
     out.reason = buf;
     return out;
   }
-  og::PathGeometric g = ss.getSolutionPath();
-  SeededSimplifier simplifier(si, seed);
-  simplifier.reduceVertices(g);
-  simplifier.shortcutPath(g);
-  simplifier.reduceVertices(g);
+  og::PathGeometric& g = *found;
 
   // The spline through the waypoints bulges off the planned polyline; where
   // that takes the body nearer than half the clearance asked for, waypoints

@@ -90,10 +90,6 @@ Eigen::VectorXd limbValues(const Configuration& q, const std::vector<int>& joint
   return v;
 }
 
-// The bodies the limb is checked against: the two witnesses and their midpoint.
-std::vector<Configuration> bodies(const Configuration& q0, const Configuration& q1) {
-  return {q0, lerp(q0, q1, 0.5), q1};
-}
 
 }  // namespace
 
@@ -177,11 +173,8 @@ LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int
   start[n] = 0;
   goal[n] = 1;
   ss.setStartAndGoalStates(start, goal);
-  ss.setPlanner(std::make_shared<SeededRRTConnect>(si, seed));
-  ss.setup();
-  // Bounded by state checks, not time: the same path under any load.
-  const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition([&] { return checks >= o.max_checks; }));
-  if (st != ob::PlannerStatus::EXACT_SOLUTION) {
+  const std::optional<og::PathGeometric> found = solveSeededRRTConnect(ss, seed, checks, o.max_checks);
+  if (!found) {
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "OMPL (RRTConnect) found no path for the limb's %d joints, %.0f mm clear, in %ld state checks", n,
@@ -189,11 +182,7 @@ LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int
     out.reason = buf;
     return out;
   }
-  og::PathGeometric g = ss.getSolutionPath();
-  SeededSimplifier simplifier(si, seed);
-  simplifier.reduceVertices(g);
-  simplifier.shortcutPath(g);
-  simplifier.reduceVertices(g);
+  const og::PathGeometric& g = *found;
   // The progress made increasing: its running maximum, blended half and
   // half with the limb's share of its own joint-space length (strictly
   // increasing wherever the limb moves).
