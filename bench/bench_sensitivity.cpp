@@ -1,0 +1,91 @@
+// How much the contact search depends on the last bits of its witnesses: one
+// scenario planned under perturbations that change no stance's validity,
+// only the numbers the posture generator returns: the start's base moved by
+// 1e-9 m, the other distance engine (FCL for the generator's own GJK), the
+// KKT variant (exact Hessian instead of L-BFGS in the KKT system), Ipopt's
+// other barrier oracle, the seed. Prints each run (result, nodes, seconds)
+// and the spread: the median, and the largest and smallest over the median.
+// Usage: bench_sensitivity [SCENARIO] [OPTIONS]   (default: chair_table); --help lists the options.
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_checks.h"
+
+#include "planner/posture/heap_tuning.h"
+#include "planner/search/planner_parameters.h"
+
+using namespace acyclic;
+
+namespace {
+
+struct Variant {
+  std::string name;
+  std::function<void(Scenario&, PlannerParameters&)> apply;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
+  std::string path = ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml";
+  double max_seconds = -1;
+  int threads = 2;
+  CLI::App app{"One scenario planned under perturbations that change only the last bits of the witnesses (the start\n"
+               "moved by 1e-9 m, the other distance engine, KKT variant or barrier oracle, the seed): each run's\n"
+               "result, nodes and time, and the spread of the node counts about their median."};
+  app.add_option("scenario", path, "scenario file (acyclic.scenario/1; default: models/scenarios/chair_table.yaml)");
+  app.add_option("--max-seconds", max_seconds, "time budget per run, s (default: the scenario's)")
+      ->check(acyclic::bench::positive());
+  app.add_option("--threads", threads, "posture generators at once (the plan does not depend on it)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  auto shift = [](int axis, double by) {
+    return [axis, by](Scenario& sc, PlannerParameters&) { sc.start.base_position[axis] += by; };
+  };
+  const std::vector<Variant> variants = {
+      {"as shipped", [](Scenario&, PlannerParameters&) {}},
+      {"start x + 1e-9 m", shift(0, 1e-9)},
+      {"start y + 1e-9 m", shift(1, 1e-9)},
+      {"start z + 1e-9 m", shift(2, 1e-9)},
+      {"start x - 1e-9 m", shift(0, -1e-9)},
+      {"distance engine fcl",
+       [](Scenario&, PlannerParameters& p) { p.posture.distance_engine = DistanceEngine::Fcl; }},
+      {"exact Hessian in KKT", [](Scenario&, PlannerParameters& p) { p.posture.lbfgs_in_kkt = false; }},
+      {"mu oracle probing", [](Scenario&, PlannerParameters& p) { p.posture.mu_oracle = "probing"; }},
+      {"seed 2", [](Scenario& sc, PlannerParameters&) { sc.seed = 2; }},
+  };
+  std::printf("%-22s %-16s %7s %9s\n", "perturbation", "result", "nodes", "seconds");
+  std::vector<double> nodes;
+  int solved = 0;
+  for (const auto& v : variants) {
+    Scenario sc = Scenario::load(path);
+    PlannerParameters p = plannerParameters(sc);
+    if (max_seconds > 0) p.max_seconds = max_seconds;
+    p.threads = threads;
+    v.apply(sc, p);
+    const PlanningResult r = ContactPlanner(sc, p).plan();
+    std::printf("%-22s %-16s %7ld %9.2f\n", v.name.c_str(), toString(r.status), r.stats.nodes_generated,
+                r.stats.seconds);
+    std::fflush(stdout);
+    if (r.solved()) ++solved, nodes.push_back(static_cast<double>(r.stats.nodes_generated));
+  }
+  std::printf("solved %d of %zu", solved, variants.size());
+  if (!nodes.empty()) {
+    const double m = median(nodes);
+    std::printf("; nodes of the solved runs: median %.0f, largest %.2fx and smallest %.2fx the median", m,
+                *std::max_element(nodes.begin(), nodes.end()) / m, *std::min_element(nodes.begin(), nodes.end()) / m);
+  }
+  std::printf("\n");
+  return 0;
+}
