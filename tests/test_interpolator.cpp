@@ -848,8 +848,11 @@ TEST(Interpolator, AFootHangingFromItsThighOnTheSeatSwingsDownToTheFloor) {
   const int foot = sc.robot->spotIndex("l_sole");
   const Eigen::Vector3d at = spotAt(sc, plan.stances[1].configuration, foot).translation();
   const int last = r.trajectory.samples.back().phase;
-  for (const auto& sample : r.trajectory.samples)
-    if (sample.phase == last) EXPECT_LT((spotAt(sc, sample.q, foot).translation() - at).norm(), 1e-3);
+  for (const auto& sample : r.trajectory.samples) {
+    if (sample.phase == last) {
+      EXPECT_LT((spotAt(sc, sample.q, foot).translation() - at).norm(), 1e-3);
+    }
+  }
 }
 
 TEST(Interpolator, BadInputAndCancellation) {
