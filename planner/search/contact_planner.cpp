@@ -272,16 +272,12 @@ struct ContactPlanner::Impl {
     }
     // A limb hanging from a contact both hold must swing from the parent's
     // witness to this one clear of the obstacles (swing_check.h); counted
-    // with the check's refusals.
+    // with the check's refusals. Both hold every contact of the parent: a
+    // son's transition stance is its parent's contacts with one added, or
+    // with one no longer supporting, at the same place.
     if (p.swing_check && n.parent >= 0) {
       const Node& par = nodes[n.parent];
-      std::vector<ContactSpec> held;
-      for (const auto& c : par.contacts)
-        for (const auto& t : n.transition)
-          if (c.spot == t.spot && c.surface == t.surface && std::abs(c.placement.x - t.placement.x) <= 1e-9 &&
-              std::abs(c.placement.y - t.placement.y) <= 1e-9)
-            held.push_back(c);
-      if (!checkHangingSwings(sc, collisions, kin, held, par.q, n.q).empty()) {
+      if (!checkHangingSwings(sc, collisions, kin, par.contacts, par.q, n.q).empty()) {
         ++stats.check_refusals;
         return -1;
       }
