@@ -407,17 +407,19 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     // Then each again with the free limbs on paths of their own (freeEnds):
     // a free foot that the witnesses' interpolation swings into the other
     // foot or a chair's leg.
+    std::vector<FreeEnd> free;
     if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths) {
-      const std::vector<FreeEnd> free = freeEnds(plan, d, false);
+      free = freeEnds(plan, d);
       if (!free.empty()) out.ok = tryPaths(&free, "with the free limbs on their own paths, ");
     }
     // Last, with the joints of each free limb that their interpolation
     // sweeps through an obstacle planned (an elbow through a table's edge,
     // which no path of the hand alone keeps clear).
     if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths && opt_.limb_joint_paths) {
-      const std::vector<FreeEnd> free = freeEnds(plan, d, true);
-      const bool planned_joints = std::any_of(free.begin(), free.end(), [](const FreeEnd& f) { return f.joints.has_value(); });
-      if (planned_joints) out.ok = tryPaths(&free, "with the free limbs' joints planned, ");
+      const std::vector<FreeEnd> planned = withPlannedJoints(plan, d, free);
+      const bool planned_joints =
+          std::any_of(planned.begin(), planned.end(), [](const FreeEnd& f) { return f.joints.has_value(); });
+      if (planned_joints) out.ok = tryPaths(&planned, "with the free limbs' joints planned, ");
     }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
@@ -525,7 +527,6 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   return true;
 }
 
-
 // The free limbs (no contact on them, and not the moving body's): each one's
 // end (its most distal spot: a foot, a palm) on a path of its own from where
 // the first witness has it to where the last does, straight, or planned
@@ -533,8 +534,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
 // beside the other foot to behind it). Left to the witnesses' interpolation
 // alone, in joint space, it can swing into an obstacle, slide along it from
 // knot to knot, and jump past it.
-std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& plan, const TransitionDesign& d,
-                                                                  bool plan_joints) {
+std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& plan, const TransitionDesign& d) {
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   const RobotModel& m = *sc_.robot;
@@ -553,12 +553,21 @@ std::vector<TransitionSolver::FreeEnd> TransitionSolver::freeEnds(const Plan& pl
       BodyPathPlan planned = planBodyPath(path, m, *sc_.scene, e, others, po);
       if (planned.path) path = std::move(*planned.path);
     }
-    out.push_back({e, std::move(path), plan_joints ? plannedLimbJoints(q0, q1, m.spotLimbRootJoint(e)) : std::nullopt});
+    out.push_back({e, std::move(path), std::nullopt});
   }
+  return out;
+}
+
+std::vector<TransitionSolver::FreeEnd> TransitionSolver::withPlannedJoints(const Plan& plan, const TransitionDesign& d,
+                                                                           std::vector<FreeEnd> out) {
+  const Configuration& q0 = plan.stances[d.from].configuration;
+  const Configuration& q1 = plan.stances[d.to].configuration;
+  const RobotModel& m = *sc_.robot;
+  for (auto& f : out) f.joints = plannedLimbJoints(q0, q1, m.spotLimbRootJoint(f.spot));
   // The joints beyond the moving body in its own limb (a hand beyond a
   // forearm that leaves the table), which its path does not hold: planned
   // the same way where their interpolation sweeps them into an obstacle.
-  if (plan_joints && d.spot >= 0) {
+  if (d.spot >= 0) {
     const int link = m.spots()[d.spot].link;
     for (const auto& j : m.joints()) {
       if (j.parent_link != link) continue;

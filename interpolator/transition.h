@@ -155,8 +155,11 @@ class TransitionSolver {
   // of its own between its witness positions (none: nullptr).
   bool solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path, double orientation_tolerance,
                  const std::vector<FreeEnd>* free_ends, Attempt& at);
-  // `plan_joints`: also the joints of each limb that their interpolation sweeps into an obstacle.
-  std::vector<FreeEnd> freeEnds(const Plan& plan, const TransitionDesign& d, bool plan_joints);
+  std::vector<FreeEnd> freeEnds(const Plan& plan, const TransitionDesign& d);
+  // `free` (freeEnds') with the joints of each limb that their interpolation
+  // sweeps into an obstacle planned, and the joints beyond the moving body
+  // in its own limb where they do.
+  std::vector<FreeEnd> withPlannedJoints(const Plan& plan, const TransitionDesign& d, std::vector<FreeEnd> free);
   // Per limb with no contact in the transition (and not the moving body's), its most distal spot.
   std::vector<int> freeLimbEnds(const TransitionDesign& d) const;
   // The joints `root` moves (a limb, or what lies beyond the moving body in
