@@ -49,14 +49,6 @@ Configuration LimbJointPath::apply(const Configuration& q, double s) const {
   return out;
 }
 
-std::vector<int> limbJoints(const RobotModel& robot, int root_joint) {
-  std::vector<int> out;
-  for (const auto& j : robot.joints())
-    if (robot.jointMovesLink(root_joint, j.child_link)) out.push_back(j.index);
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 namespace {
 
 // Which pairs have a link of the limb on one side (and not on both: the
@@ -107,7 +99,7 @@ LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int
   LimbPathPlan out;
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   const RobotModel& robot = kin.model();
-  const std::vector<int> joints = limbJoints(robot, root_joint);
+  const std::vector<int> joints = robot.jointsMovedBy(root_joint);
   const std::vector<bool> pairs = limbPairs(collisions, robot, root_joint);
   const int n = static_cast<int>(joints.size());
   if (n == 0) {

@@ -63,9 +63,6 @@ struct LimbPathPlan {
   std::string reason;                 // why not, otherwise
 };
 
-// The joints moved by `root_joint` (a limb's first joint), in controller order.
-std::vector<int> limbJoints(const RobotModel& robot, int root_joint);
-
 // The least clearance of the limb's links (those `root_joint` moves) to the
 // obstacles and the robot's other links along the straight interpolation of
 // its joints from q0's to q1's, the rest of the body on the witnesses'

@@ -309,7 +309,7 @@ TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEach
   const CollisionModel collisions(sc.robot, sc.scene);
   Kinematics kin(sc.robot);
   const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_palm"));
-  const std::vector<int> joints = limbJoints(*sc.robot, root);
+  const std::vector<int> joints = sc.robot->jointsMovedBy(root);
   ASSERT_EQ(joints.size(), 7u);  // LARM_JOINT0..6
   EXPECT_EQ(sc.robot->joints()[joints.front()].name, "LARM_JOINT0");
   EXPECT_LT(limbSweepClearance(collisions, kin, root, q0, q1, 0.01), -0.05);

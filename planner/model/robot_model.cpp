@@ -371,4 +371,11 @@ Configuration RobotModel::readConfiguration(const YamlField& f) const {
   return q;
 }
 
+std::vector<int> RobotModel::jointsMovedBy(int joint) const {
+  std::vector<int> out;
+  for (const auto& j : joints_)
+    if (jointMovesLink(joint, j.child_link)) out.push_back(j.index);
+  return out;
+}
+
 }  // namespace acyclic

@@ -92,6 +92,8 @@ class RobotModel {
   // Static tree structure (controller joint indices):
   const std::vector<int>& ancestorJoints(int link) const { return ancestors_[link]; }  // base to link
   bool jointMovesLink(int joint, int link) const { return moves_[joint][link]; }
+  // The joints `joint` moves, itself included (a limb's, from its root), in controller order.
+  std::vector<int> jointsMovedBy(int joint) const;
   double subtreeMass(int joint) const { return subtree_mass_[joint]; }  // links moved by the joint
   // The joint a link's limb hangs from: the last one on the way from the base
   // whose parent link branches (a leg's hip yaw, an arm's shoulder); -1 for

@@ -39,9 +39,7 @@ std::string checkHangingSwings(const Scenario& sc, const CollisionModel& collisi
       bool closed = false;
       for (const auto& c : held) closed = closed || m.jointMovesLink(j.index, m.spots()[c.spot].link);
       if (closed) continue;
-      std::vector<int> joints;
-      for (const auto& k : m.joints())
-        if (m.jointMovesLink(j.index, k.child_link)) joints.push_back(k.index);
+      const std::vector<int> joints = m.jointsMovedBy(j.index);
       bool moves = false;
       for (int k : joints) moves = moves || a.joints[k] != b.joints[k];
       if (!moves) continue;
