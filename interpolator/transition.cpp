@@ -441,9 +441,9 @@ bool TransitionSolver::hangsFromItsLimb(const TransitionDesign& d) const {
   for (const auto& c : d.motion_contacts) {
     const int held = m.spots()[c.spot].link;
     if (held == link) continue;
-    // The held link is an ancestor of the moving one: a joint below it moves the body.
-    for (const auto& j : m.joints())
-      if (j.parent_link == held && m.jointMovesLink(j.index, link)) return true;
+    // The held link is an ancestor of the moving one: a joint on the way to the body hangs from it.
+    for (int j : m.ancestorJoints(link))
+      if (m.joints()[j].parent_link == held) return true;
   }
   return false;
 }
