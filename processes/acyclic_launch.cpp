@@ -48,6 +48,11 @@ struct Listener {
   proc::StatusReporter& status;
   std::int64_t request_id = 0;
   std::map<std::string, int> status_seen;  // process -> status messages since (re)start
+  // Idle reports since the launcher last handed that process work: a process
+  // idle for three heartbeats without having answered never got the work, or
+  // its answer never arrived (UDP drops a message when a socket's receive
+  // buffer is full, e.g. under a flood).
+  std::map<std::string, int> idle_since_work;
   std::optional<plan_t> plan;
   std::optional<trajectory_t> trajectory;
   std::optional<hrp2_bridge_status_t> played;   // the bridge's last status about our request
@@ -58,6 +63,7 @@ struct Listener {
     if (!proc::decode(rb, channel, m, status)) return;
     if (m.pid == getpid()) return;  // its own reports (already said)
     ++status_seen[m.process];
+    if (m.state == process_status_t::IDLE) ++idle_since_work[m.process];
     if (m.state == process_status_t::ERROR)
       say(m.process + " reports an error" +
           (m.request_id >= 0 ? " on request " + std::to_string(m.request_id) : std::string()) + ": " + m.reason);
@@ -213,9 +219,11 @@ int main(int argc, char** argv) {
     };
     bool request_sent = false, plan_sent_on = false, failed = false, done = false;
     bool lost_work_plan = false, trajectory_written = false;
+    int resent = 0;  // work handed again after it was lost on the way (kMaxResends at most)
+    constexpr int kMaxResends = 3, kIdleReportsMeanLost = 3;
     double play_deadline = 0;
     while (!proc::stopRequested() && !done && !failed) {
-      bus.lcm().handleTimeout(50);
+      proc::handlePending(bus, 50);
       std::vector<std::string> gone;
       for (const auto& name : sup.poll(&gone)) {
         ear.status_seen[name] = 0;  // wait for the new instance's first status
@@ -246,7 +254,22 @@ int main(int argc, char** argv) {
         req.utime = proc::nowMicros();
         bus.publish(channels::kRequest, req);
         request_sent = true;
+        ear.idle_since_work["acyclic-planner"] = 0;
         say("request " + std::to_string(request_id) + " sent: " + sc.name);
+      }
+      if (!ear.plan && ear.idle_since_work["acyclic-planner"] >= kIdleReportsMeanLost && resent < kMaxResends) {
+        say("acyclic-planner is idle and no plan came: the request or the plan was lost on the way; sending it again");
+        ++resent;
+        request_sent = false;
+        continue;
+      }
+      if (ear.plan && ear.plan->status == plan_t::OK && !no_interpolate && !ear.trajectory && !trajectory_written &&
+          ear.idle_since_work["acyclic-interpolator"] >= kIdleReportsMeanLost && resent < kMaxResends) {
+        say("acyclic-interpolator is idle and no trajectory came: the plan or the trajectory was lost on the way; "
+            "sending the plan again");
+        ++resent;
+        lost_work_plan = true;
+        ear.idle_since_work["acyclic-interpolator"] = 0;
       }
       // The interpolator restarted after the plan went out: hand it the plan again.
       if (lost_work_plan && ear.plan && ear.status_seen["acyclic-interpolator"] > 0) {
@@ -255,6 +278,7 @@ int main(int argc, char** argv) {
       }
       if (ear.plan && !plan_sent_on) {
         plan_sent_on = true;
+        ear.idle_since_work["acyclic-interpolator"] = 0;  // the interpolator heard the plan too
         if (ear.tty) std::fprintf(stderr, "\n");
         const plan_t& m = *ear.plan;
         say("plan: status " + std::to_string(m.status) + (m.reason.empty() ? "" : " (" + m.reason + ")") + ", " +

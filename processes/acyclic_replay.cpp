@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
         if (proc::stopRequested()) throw std::runtime_error("interrupted");
         if (std::chrono::steady_clock::now() - t0 > std::chrono::duration<double>(timeout_s))
           throw std::runtime_error("no " + what + " within " + std::to_string(static_cast<int>(timeout_s)) + " s");
-        bus.lcm().handleTimeout(50);
+        proc::handlePending(bus, 50);
         sup.poll();
       }
     };

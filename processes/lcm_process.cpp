@@ -158,6 +158,14 @@ int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<boo
   return 0;
 }
 
+int handlePending(Bus& bus, int wait_ms, int max_messages) {
+  int r = bus.lcm().handleTimeout(wait_ms);
+  if (r <= 0) return r;
+  int n = 1;
+  while (n < max_messages && (r = bus.lcm().handleTimeout(0)) > 0) ++n;
+  return r < 0 ? r : n;
+}
+
 bool Worker::start(std::int64_t request_id, std::function<void(const std::atomic<bool>&)> job) {
   if (running_) return false;
   reap();

@@ -130,6 +130,14 @@ class Worker {
 int spin(Bus& bus, const std::function<void()>& on_tick, const std::function<bool()>& done = {},
          int period_ms = 50, const std::function<void(const std::string&)>& on_handler_error = {});
 
+// Waits up to wait_ms for a message, then dispatches every message already
+// queued (max_messages at most, so that a flood cannot starve the caller).
+// A loop that does other work between calls (a supervisor's poll) must drain
+// so: one message per pass lets a burst overflow the socket's receive buffer,
+// and UDP then drops the message the loop was waiting for. Returns the number
+// dispatched, or < 0 when LCM failed.
+int handlePending(Bus& bus, int wait_ms, int max_messages = 10000);
+
 // Logs "process: message" to stderr with a timestamp (the process's log).
 void log(const std::string& process, const std::string& message);
 

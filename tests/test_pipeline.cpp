@@ -543,7 +543,8 @@ TEST(Pipeline, TheLauncherSurvivesFuzzOnEveryChannelItHears) {
   // (which takes about a second).
   std::thread launcher([&] {
     run = test::runProcess(exe("acyclic-launch") + " -q --no-interpolate --scenario " +
-                           test::sourcePath("models/scenarios/step_forward.yaml") + " --out " + dir.path());
+                           test::sourcePath("models/scenarios/step_forward.yaml") + " --out " + dir.path() +
+                           " --timeout 60");
     finished = true;
   });
   while (!finished) {
@@ -557,6 +558,58 @@ TEST(Pipeline, TheLauncherSurvivesFuzzOnEveryChannelItHears) {
   EXPECT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(fs::exists(dir.path() + "/plan.json")) << run.output;
   EXPECT_NE(run.output.find("does not decode"), std::string::npos) << run.output;
+}
+
+// UDP drops a message when a socket's receive buffer is full. A planner that
+// stays idle for three heartbeats after the request went out never got it:
+// the launcher sends it again. Here the test plays the pipeline's planner and
+// guide author (--external), ignores the first request and answers the second.
+TEST(Pipeline, TheLauncherSendsItsRequestAgainWhenThePlannerStaysIdleWithoutAnswering) {
+  REQUIRE_NETNS();
+  test::TempDir dir;
+  std::atomic<bool> finished{false};
+  test::ProcessRun run;
+  struct FakePlanner {
+    proc::Bus& bus;
+    std::vector<request_t> requests;
+    void onRequest(const lcm::ReceiveBuffer*, const std::string&, const request_t* m) {
+      requests.push_back(*m);
+      if (requests.size() < 2) return;  // the first one is "lost"
+      plan_t p{};
+      p.utime = proc::nowMicros();
+      p.request_id = m->request_id;
+      p.status = plan_t::ERROR;
+      p.reason = "answered the second request";
+      bus.publish(channels::kPlan, p);
+    }
+  };
+  Client c;
+  FakePlanner fake{c.bus, {}};
+  c.bus.lcm().subscribe(channels::kRequest, &FakePlanner::onRequest, &fake);
+  std::thread launcher([&] {
+    run = test::runProcess(exe("acyclic-launch") + " -q --external --no-interpolate --timeout 60 --scenario " +
+                           test::sourcePath("models/scenarios/step_forward.yaml") + " --out " + dir.path());
+    finished = true;
+  });
+  while (!finished) {
+    for (const char* name : {"acyclic-guide", "acyclic-planner"}) {
+      process_status_t st{};
+      st.utime = proc::nowMicros();
+      st.process = name;
+      st.pid = 1;
+      st.state = process_status_t::IDLE;
+      st.request_id = -1;
+      c.bus.publish(channels::kStatus, st);
+    }
+    c.waitFor([] { return false; }, 0.2);
+  }
+  launcher.join();
+  EXPECT_EQ(run.status, 1) << run.output;  // the plan's status is ERROR
+  ASSERT_EQ(fake.requests.size(), 2u) << run.output;
+  EXPECT_EQ(fake.requests[0].request_id, fake.requests[1].request_id);
+  EXPECT_EQ(fake.requests[0].scenario_yaml, fake.requests[1].scenario_yaml);
+  EXPECT_NE(run.output.find("sending it again"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("answered the second request"), std::string::npos) << run.output;
 }
 
 TEST(Pipeline, ReplayOfALogWithUndecodableMessagesSaysSoAndDoesNotCrash) {
