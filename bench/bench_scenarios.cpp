@@ -14,6 +14,9 @@
 
 #include "cli_checks.h"
 
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+#include "interpolator/plan_verifier.h"
+#endif
 #include "planner/check/plan_check.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/search/planner_parameters.h"
@@ -30,6 +33,12 @@ int main(int argc, char** argv) {
   app.add_option("scenario", paths, "scenario files (acyclic.scenario/1; default: every models/scenarios/*.yaml)");
   app.add_option("--max-seconds", max_seconds, "time budget per scenario, s (default: the scenario's)")
       ->check(acyclic::bench::positive());
+  bool verify = false;
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+  app.add_flag("--verify-transitions", verify,
+               "verify each plan's transitions with the interpolator's solver, as acyclic-planner does by default "
+               "(default here: the search alone, or the scenario's planner key verify_transitions)");
+#endif
   CLI11_PARSE(app, argc, argv);
   if (paths.empty()) {
     for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
@@ -42,6 +51,10 @@ int main(int argc, char** argv) {
     const Scenario sc = Scenario::load(path);
     PlannerParameters p = plannerParameters(sc);
     if (max_seconds > 0) p.max_seconds = max_seconds;
+    if (verify) p.verify_transitions = true;
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+    attachPlanVerifier(p, sc);
+#endif
     const PlanningResult r = ContactPlanner(sc, p).plan();
     std::string verdict = "-", used;
     if (r.solved()) {
@@ -58,6 +71,10 @@ int main(int argc, char** argv) {
     std::printf("%-14s %-16s %9.2f %7ld %7ld %7ld %8zu %-7s %s\n", sc.name.c_str(), toString(r.status),
                 r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures,
                 r.plan.stances.size(), verdict.c_str(), used.empty() ? "none" : used.c_str());
+    if (r.stats.plans_verified > 0)
+      std::printf("%-14s   transitions verified: %ld plans, %ld refused, %ld transitions solved, %.2f s of the %.2f s\n",
+                  "", r.stats.plans_verified, r.stats.plans_refused, r.stats.transitions_solved,
+                  r.stats.verify_seconds, r.stats.seconds);
     std::fflush(stdout);
   }
   return 0;

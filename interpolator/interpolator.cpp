@@ -63,6 +63,34 @@ std::string validateOptions(const InterpolatorOptions& o) {
 
 }  // namespace
 
+TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
+  TransitionOptions to;
+  to.steps = opt.steps;
+  to.fixed_step = opt.fixed_step;
+  to.lift = opt.lift;
+  to.touch_clearance = opt.touch_clearance;
+  to.air_orientation_tolerance = opt.air_orientation_tolerance;
+  to.repair_attempts = opt.repair_attempts;
+  to.repair_step = opt.repair_step;
+  to.plan_body_path = opt.plan_body_path;
+  to.free_limb_paths = opt.free_limb_paths;
+  to.limb_joint_paths = opt.limb_joint_paths;
+  to.refine_depth = opt.refine_depth;
+  to.wide_clearance = opt.wide_clearance;
+  to.posture.max_iterations = opt.posture_iterations;
+  to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
+  to.posture.problem.collision_cutoff = opt.collision_cutoff;
+  to.posture.problem.pyramid_sides = opt.pyramid_edges;
+  to.posture.problem.support_inset = opt.support_inset;
+  to.posture.problem.support_inset_y = opt.support_inset_y;
+  to.posture.problem.friction_share = opt.friction_share;
+  to.posture.ipopt_options = opt.posture_ipopt_options;
+  to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
+  to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};
+  to.verify_samples = opt.verify_samples;
+  return to;
+}
+
 InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& opt,
                                 const std::function<void(const InterpolationProgress&)>& progress,
                                 const std::atomic<bool>* cancel) {
@@ -93,30 +121,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
     }
   }
 
-  TransitionOptions to;
-  to.steps = opt.steps;
-  to.fixed_step = opt.fixed_step;
-  to.lift = opt.lift;
-  to.touch_clearance = opt.touch_clearance;
-  to.air_orientation_tolerance = opt.air_orientation_tolerance;
-  to.repair_attempts = opt.repair_attempts;
-  to.repair_step = opt.repair_step;
-  to.plan_body_path = opt.plan_body_path;
-  to.free_limb_paths = opt.free_limb_paths;
-  to.limb_joint_paths = opt.limb_joint_paths;
-  to.refine_depth = opt.refine_depth;
-  to.wide_clearance = opt.wide_clearance;
-  to.posture.max_iterations = opt.posture_iterations;
-  to.posture.max_seconds = 1e6;  // bounded by iterations: deterministic under any load
-  to.posture.problem.collision_cutoff = opt.collision_cutoff;
-  to.posture.problem.pyramid_sides = opt.pyramid_edges;
-  to.posture.problem.support_inset = opt.support_inset;
-  to.posture.problem.support_inset_y = opt.support_inset_y;
-  to.posture.problem.friction_share = opt.friction_share;
-  to.posture.ipopt_options = opt.posture_ipopt_options;
-  to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
-  to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};
-  to.verify_samples = opt.verify_samples;
+  const TransitionOptions to = transitionOptions(opt);
   TransitionSolver solver(sc, to);
   Trajectory& tr = res.trajectory;
   tr.scenario = plan.scenario;

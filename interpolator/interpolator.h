@@ -77,6 +77,10 @@ struct InterpolationResult {
 
 const char* toString(InterpolationResult::Status s);
 
+// The transition solver's options the interpolator uses for these options
+// (the plan verifier, plan_verifier.h, solves with the same).
+TransitionOptions transitionOptions(const InterpolatorOptions& options);
+
 InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& options,
                                 const std::function<void(const InterpolationProgress&)>& progress = {},
                                 const std::atomic<bool>* cancel = nullptr);

@@ -53,9 +53,19 @@ int main(int argc, char** argv) {
                "ablation: try every pair at every node, even where it just failed from the same place");
   app.add_flag("--no-swing-check", o.no_swing_check,
                "ablation: accept sons whose limb hanging from a shared contact cannot swing to its new place");
+  bool verify = false, no_verify = false;
+  auto* verify_flag = app.add_flag(
+      "--verify-transitions", verify,
+      "solve every transition of a plan found as the interpolator will, and drop the stance of the first that "
+      "cannot be made and search on (default: the scenario's planner key verify_transitions, else on when "
+      "built with the interpolator)");
+  app.add_flag("--no-verify-transitions", no_verify, "no verification of transitions, whatever the scenario says")
+      ->excludes(verify_flag);
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
+  if (verify) o.verify_transitions = 1;
+  if (no_verify) o.verify_transitions = 0;
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
 
   acyclic::proc::installSignalHandlers();
@@ -86,6 +96,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "\r%7.1f s  nodes %ld (expanded %ld)  posture calls %ld (failed %ld)  best f_T %.3f   ",
                    s.seconds, s.nodes_generated, s.nodes_expanded, s.posture_calls, s.posture_failures,
                    s.best_potential);
+      if (s.verifying)
+        std::fprintf(stderr, "\n%7.1f s  a plan found: verifying its transitions (%ld plans refused so far)\n",
+                     s.seconds, s.plans_refused);
     };
     const acyclic::PlanningResult r = planner.plan(&acyclic::proc::stopFlag(), progress);
     if (tty) std::fprintf(stderr, "\n");
@@ -94,6 +107,9 @@ int main(int argc, char** argv) {
                 "%ld pairs skipped by the failure memory, %ld calls solved ahead and not used\n",
                 sc.name.c_str(), acyclic::toString(r.status), s.seconds, s.nodes_generated, s.nodes_expanded,
                 s.posture_calls, s.posture_failures, s.pairs_remembered, s.calls_ahead_unused);
+    if (s.plans_verified > 0)
+      std::printf("acyclic-planner: transitions verified: %ld plans checked, %ld refused, %ld transitions solved, "
+                  "%.2f s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds);
     if (!r.solved()) {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
       return 1;

@@ -12,11 +12,22 @@
 #include "acyclic/progress_t.hpp"
 #include "acyclic/request_t.hpp"
 #include "lcmtypes/channels.hpp"
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+#include "interpolator/plan_verifier.h"
+#endif
 #include "planner/search/planner_parameters.h"
 #include "processes/lcm_convert.h"
 #include "processes/lcm_process.h"
 
 namespace acyclic {
+
+namespace {
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+constexpr bool kVerifyTransitionsByDefault = true;
+#else
+constexpr bool kVerifyTransitionsByDefault = false;  // nothing to verify with
+#endif
+}  // namespace
 
 PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s) const {
   if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
@@ -31,6 +42,18 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   p.guide_potential = !distance_to_goal;
   if (no_failure_memory) p.failure_memory = false;
   if (no_swing_check) p.swing_check = false;
+  // Verification is on unless the scenario (planner: verify_transitions) or
+  // the command line says otherwise: a plan the interpolator cannot
+  // interpolate is no answer for the pipeline.
+  const bool scenario_says = sc.planner_section && sc.planner_section->has("verify_transitions");
+  if (verify_transitions >= 0) p.verify_transitions = verify_transitions == 1;
+  else if (!scenario_says) p.verify_transitions = kVerifyTransitionsByDefault;
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+  attachPlanVerifier(p, sc);
+#else
+  if (p.verify_transitions)
+    throw std::invalid_argument("verify_transitions: this build has no interpolator to verify transitions with");
+#endif
   if (verbose) p.trace = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   return p;
 }
@@ -179,13 +202,13 @@ class PlannerService : public proc::Service {
         std::int64_t last_progress = 0;
         auto progress = [&](const PlanningStats& s) {
           const std::int64_t now = proc::nowMicros();
-          if (now - last_progress < 250000) return;  // 4 Hz at most
+          if (now - last_progress < 250000 && !s.verifying) return;  // 4 Hz at most
           last_progress = now;
           progress_t p{};
           p.utime = now;
           p.request_id = req.request_id;
           p.source = kProcess;
-          p.stage = "search";
+          p.stage = s.verifying ? "verifying transitions" : "search";
           p.fraction = params.max_seconds > 0 ? std::min(1.0, s.seconds / params.max_seconds) : -1;
           p.nodes_generated = s.nodes_generated;
           p.posture_calls = s.posture_calls;

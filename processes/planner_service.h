@@ -14,9 +14,11 @@ struct PlannerOverrides {
   long max_nodes = -1, max_posture_calls = -1;
   int threads = -1;
   bool eager_sons = false, random_candidates = false, distance_to_goal = false, no_failure_memory = false, no_swing_check = false;
+  int verify_transitions = -1;  // -1: the scenario's (planner: verify_transitions), 0 off, 1 on
   bool verbose = false;  // one line per expanded node on stderr
   // The scenario's parameters with these overrides; a request's time budget
-  // (> 0) applies unless --max-seconds is given. Also sets sc.seed.
+  // (> 0) applies unless --max-seconds is given. Also sets sc.seed. With
+  // verify_transitions, the interpolator's verifier (built only with it).
   PlannerParameters apply(Scenario& sc, double request_budget_s) const;
 };
 

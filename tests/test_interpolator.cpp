@@ -13,6 +13,7 @@
 #include "interpolator/body_path.h"
 #include "interpolator/body_path_planner.h"
 #include "interpolator/interpolator.h"
+#include "interpolator/plan_verifier.h"
 #include "interpolator/limb_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/check/trajectory_check.h"
@@ -981,4 +982,41 @@ TEST(InterpolatorProcess, HelpAndBadInput) {
   EXPECT_EQ(noscen.status, 2) << noscen.output;
   EXPECT_NE(noscen.output.find("field 'scenario'"), std::string::npos) << noscen.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/t.json"));
+}
+
+// The planner's lazy verification (interpolator/plan_verifier.h) says what
+// the interpolator will do: tests/data/chair_ompl_arm_over_edge.plan.json
+// cannot be interpolated without the free arm's joints planned, and can with
+// them; a transition once solved is remembered, not solved again.
+TEST(PlanVerifier, RefusesWhatTheInterpolatorCannotDoAndRemembersWhatItSolved) {
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  std::atomic<bool> stop{false};
+  InterpolatorOptions without;
+  without.limb_joint_paths = false;
+  TransitionVerifier weak(sc, without);
+  const PlanVerdict refused = weak.verify(plan, stop);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_FALSE(refused.stopped);
+  EXPECT_EQ(refused.failed_from, 0);
+  EXPECT_EQ(refused.failed_to, 1);
+  EXPECT_FALSE(refused.reason.empty());
+  EXPECT_FALSE(interpolate(plan, sc, without).success());  // the interpolator agrees
+
+  TransitionVerifier full(sc, InterpolatorOptions{});
+  const PlanVerdict ok = full.verify(plan, stop);
+  EXPECT_TRUE(ok.ok()) << ok.reason;
+  EXPECT_EQ(ok.transitions, 1);
+  EXPECT_EQ(ok.solved, 1);
+  const PlanVerdict again = full.verify(plan, stop);
+  EXPECT_TRUE(again.ok());
+  EXPECT_EQ(again.solved, 0);  // remembered
+  EXPECT_EQ(full.remembered(), 1u);
+  // A raised stop flag: nothing solved, the verdict says so.
+  TransitionVerifier fresh(sc, InterpolatorOptions{});
+  stop = true;
+  const PlanVerdict stopped = fresh.verify(plan, stop);
+  EXPECT_TRUE(stopped.stopped);
+  EXPECT_FALSE(stopped.ok());
 }

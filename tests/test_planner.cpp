@@ -365,3 +365,72 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
     }
   }
 }
+
+// Lazy verification (PlannerParameters::verify_transitions): a plan whose
+// transition the verifier refuses is not returned; the stance that
+// transition leads to is dropped with its subtree and the search goes on to
+// another plan, which the verifier sees too. Here a verifier that refuses
+// the first plan's transition into its second stance.
+TEST(ContactPlanner, APlanWhoseTransitionTheVerifierRefusesIsDroppedAndTheSearchGoesOn) {
+  const Scenario& sc = step();
+  const PlanningResult plain = ContactPlanner(sc).plan();
+  ASSERT_TRUE(plain.solved()) << plain.reason;
+  ASSERT_GE(plain.plan.stances.size(), 3u);
+  const Configuration refused = plain.plan.stances[1].configuration;
+  auto same = [](const Configuration& a, const Configuration& b) {
+    return a.base_position == b.base_position && a.joints == b.joints;
+  };
+  PlannerParameters p;
+  p.verify_transitions = true;
+  std::vector<Plan> seen;
+  p.verify_plan = [&](const Plan& plan, const std::atomic<bool>&) {
+    seen.push_back(plan);
+    PlanVerdict v;
+    v.transitions = static_cast<int>(plan.stances.size()) - 1;
+    for (std::size_t k = 1; k < plan.stances.size(); ++k)
+      if (same(plan.stances[k].configuration, refused)) {
+        v.failed_from = static_cast<int>(k) - 1, v.failed_to = static_cast<int>(k);
+        v.reason = "refused by the test";
+        break;
+      }
+    return v;
+  };
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);
+  ASSERT_GE(seen.size(), 2u);
+  EXPECT_EQ(seen.front().stances.size(), plain.plan.stances.size());  // the plain search's plan, first
+  EXPECT_EQ(r.stats.plans_verified, static_cast<long>(seen.size()));
+  EXPECT_EQ(r.stats.plans_refused, static_cast<long>(seen.size()) - 1);
+  for (const auto& st : r.plan.stances) EXPECT_FALSE(same(st.configuration, refused));
+  EXPECT_GT(r.stats.nodes_generated, plain.stats.nodes_generated);
+  // The same search again: the same plan (the verifier's verdicts are a function of the plan).
+  seen.clear();
+  const PlanningResult again = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(again.solved());
+  ASSERT_EQ(again.plan.stances.size(), r.plan.stances.size());
+  for (std::size_t k = 0; k < r.plan.stances.size(); ++k)
+    EXPECT_TRUE(same(again.plan.stances[k].configuration, r.plan.stances[k].configuration)) << k;
+}
+
+// A verifier that runs past the time budget is stopped, and the search
+// says a plan was found but not verified, instead of returning it.
+TEST(ContactPlanner, AVerificationPastTheTimeBudgetIsStoppedWithTheReason) {
+  PlannerParameters p;
+  p.verify_transitions = true;
+  p.max_seconds = 5.0;  // the search alone takes well under a second
+  p.verify_plan = [](const Plan&, const std::atomic<bool>& stop) {
+    while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    PlanVerdict v;
+    v.stopped = true;
+    return v;
+  };
+  const PlanningResult r = ContactPlanner(step(), p).plan();
+  EXPECT_EQ(r.status, PlanningResult::Status::TimeLimit) << r.reason;
+  EXPECT_NE(r.reason.find("not all verified"), std::string::npos) << r.reason;
+  EXPECT_TRUE(r.plan.stances.empty());
+  // Asking for verification without a verifier is a misuse.
+  PlannerParameters none;
+  none.verify_transitions = true;
+  EXPECT_THROW(ContactPlanner(step(), none), std::invalid_argument);
+}

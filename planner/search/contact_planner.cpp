@@ -135,6 +135,8 @@ struct ContactPlanner::Impl {
   std::chrono::steady_clock::time_point t0;
   long order = 0;
   int goal_node = -1;
+  std::vector<int> stance_owner;  // exportPlan: the node each stance of the plan comes from
+  ContactPlanner::Progress progress;  // the caller's, also told when a verification starts
   const std::atomic<bool>* cancel = nullptr;  // checked before every posture call
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
@@ -144,6 +146,8 @@ struct ContactPlanner::Impl {
         rng(s.seed) {
     for (int t = 0; t < std::max(1, p.threads); ++t)
       pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
+    if (p.verify_transitions && !p.verify_plan)
+      throw std::invalid_argument("verify_transitions is set but no plan verifier was given (PlannerParameters::verify_plan)");
     if (p.guide_potential) {
       std::vector<Configuration> keys = sc.key_postures;
       if (keys.size() < 2) throw std::invalid_argument("the guide potential needs key postures (at least two)");
@@ -722,7 +726,9 @@ struct ContactPlanner::Impl {
     plan = Plan();
     plan.scenario = sc.path;
     plan.robot = sc.robot->descriptionPath();
-    auto push = [&](const std::vector<ContactSpec>& specs, const Configuration& q) {
+    stance_owner.clear();
+    auto push = [&](const std::vector<ContactSpec>& specs, const Configuration& q, int owner) {
+      stance_owner.push_back(owner);
       PlanStance st;
       st.configuration = q;
       st.potential = keyOf(q);
@@ -737,16 +743,16 @@ struct ContactPlanner::Impl {
       }
       plan.stances.push_back(st);
     };
-    push(nodes[path[0]].transition, nodes[path[0]].q);
+    push(nodes[path[0]].transition, nodes[path[0]].q, path[0]);
     for (std::size_t i = 1; i < path.size(); ++i) {
       const Node& prev = nodes[path[i - 1]];
       const Node& cur = nodes[path[i]];
       if (i >= 2) {
         // The settled stance prev.contacts: its witness touches exactly its contacts.
         if (prev.change == Change::Added) {
-          push(prev.contacts, prev.q);
+          push(prev.contacts, prev.q, path[i - 1]);
         } else if (cur.change == Change::Removed) {
-          push(prev.contacts, cur.q);
+          push(prev.contacts, cur.q, path[i]);
         } else {
           // prev was a removal and cur adds a contact: prev's witness still
           // touches with the removed contact, cur's with the added one. The
@@ -759,21 +765,54 @@ struct ContactPlanner::Impl {
             nodes[path[i]].dead = true;
             return false;
           }
-          push(prev.contacts, *settled);
+          push(prev.contacts, *settled, path[i]);
         }
       }
-      push(cur.transition, cur.q);
+      push(cur.transition, cur.q, path[i]);
     }
     // A goal met where the last addition settles ends on that stance.
     const Node& end = nodes[path.back()];
     kin.setConfiguration(end.q);
-    if (!sc.goal.satisfied(kin, end.transition)) push(end.contacts, end.q);
+    if (!sc.goal.satisfied(kin, end.transition)) push(end.contacts, end.q, path.back());
     plan.stats.nodes_generated = stats.nodes_generated;
     plan.stats.nodes_expanded = stats.nodes_expanded;
     plan.stats.posture_calls = stats.posture_calls;
     plan.stats.posture_failures = stats.posture_failures;
     plan.stats.seconds = elapsed();
     return true;
+  }
+
+  // Runs the plan verifier with a stop flag raised on a cancel or when the
+  // time budget runs out (checked every 20 ms).
+  PlanVerdict verify(const Plan& plan) {
+    const double start = elapsed();
+    if (progress) {
+      stats.seconds = start;
+      stats.verifying = true;
+      progress(stats);
+      stats.verifying = false;
+    }
+    std::atomic<bool> stop_flag{false}, done{false};
+    std::thread watch([&] {
+      while (!done.load()) {
+        if ((cancel && cancel->load()) || elapsed() > p.max_seconds) stop_flag = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    });
+    PlanVerdict v;
+    try {
+      v = p.verify_plan(plan, stop_flag);
+    } catch (...) {
+      done = true;
+      watch.join();
+      throw;
+    }
+    done = true;
+    watch.join();
+    ++stats.plans_verified;
+    stats.transitions_solved += v.solved;
+    stats.verify_seconds += elapsed() - start;
+    return v;
   }
 
   bool deadPath(int n) const {
@@ -791,6 +830,7 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   Impl& I = *impl_;
   I.t0 = std::chrono::steady_clock::now();
   I.cancel = cancel;
+  I.progress = progress;
   PlanningResult out;
   Impl::Node root;
   root.contacts = I.sc.start_stance;
@@ -813,10 +853,35 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
       // valid witness) is dropped with the node where it fails; the search
       // goes on.
       if (I.exportPlan(I.goal_node, plan)) {
-        exported = true;
-        break;
+        if (!I.p.verify_transitions) {
+          exported = true;
+          break;
+        }
+        // Lazy verification: the first transition that cannot be made drops
+        // the node its stance comes from (and so its subtree); the search
+        // goes on. Transitions solved once are remembered by the verifier.
+        const PlanVerdict v = I.verify(plan);
+        if (v.ok()) {
+          exported = true;
+          break;
+        }
+        if (v.stopped) {
+          I.budgetLeft();  // the stop's reason: cancel or a budget
+          if (I.stop == PlanningResult::Status::NoSolution) I.stop = PlanningResult::Status::TimeLimit;
+          I.stop_reason = "a plan of " + std::to_string(plan.stances.size()) +
+                          " stances was found but its transitions were not all verified: " + I.stop_reason;
+          break;
+        }
+        ++I.stats.plans_refused;
+        const int owner = I.stance_owner.at(static_cast<std::size_t>(v.failed_to));
+        if (I.p.trace)
+          I.p.trace("verification: stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
+                    " cannot be interpolated (" + v.reason.substr(0, 160) + "): node " + std::to_string(owner) +
+                    " dropped");
+        I.nodes[owner].dead = true;
+      } else {
+        ++I.stats.check_refusals;
       }
-      ++I.stats.check_refusals;
       I.goal_node = -1;
     }
     if (!I.budgetLeft()) break;

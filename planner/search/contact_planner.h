@@ -26,6 +26,21 @@
 
 namespace acyclic {
 
+// What a plan verifier says of a plan the search found (PlannerParameters::
+// verify_plan): the first transition between consecutive stances that
+// cannot be made, or none.
+struct PlanVerdict {
+  int failed_from = -1, failed_to = -1;  // plan stance indices of the first failing transition; -1: none
+  std::string reason;                    // why it fails
+  bool stopped = false;                  // the stop flag was raised before every transition was checked
+  int transitions = 0;                   // transitions in the plan
+  int solved = 0;                        // of them, solved by this call (the others were known)
+  bool ok() const { return failed_from < 0 && !stopped; }
+};
+// Checks a plan; `stop` (raised by the search on its budget or a cancel)
+// asks it to return early with `stopped`.
+using PlanVerifier = std::function<PlanVerdict(const Plan&, const std::atomic<bool>& stop)>;
+
 struct PlannerParameters {
   double potential_k = 1.0;            // slope of f_T along the guide
   double smoothing_tolerance = 0.05;   // corner blends of the guide
@@ -66,6 +81,14 @@ struct PlannerParameters {
   // foot below a thigh on the seat) cannot swing from the parent's witness
   // to its own clear of the obstacles is refused (swing_check.h).
   bool swing_check = true;
+  // Lazy verification of the transitions (beyond the paper): a plan the
+  // search finds is handed to verify_plan (in processes: the interpolator's
+  // transition solver, interpolator/plan_verifier.h); when one of its
+  // transitions cannot be made, the stance it leads to is dropped with its
+  // subtree and the search goes on. Its time counts in max_seconds. Set
+  // verify_transitions without a verifier: the planner refuses to start.
+  bool verify_transitions = false;
+  PlanVerifier verify_plan;
   double failure_memory_distance = 0.05;  // m
   double failure_memory_angle = 0.35;     // rad
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
@@ -83,6 +106,11 @@ struct PlanningStats {
   long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
   long calls_ahead_unused = 0;  // solved ahead on an idle generator, their turn never came (not in posture_calls)
   double seconds = 0, best_potential = 0;
+  // Lazy verification (verify_transitions): plans handed to the verifier,
+  // refused by it, transitions solved, and the wall time spent in it.
+  long plans_verified = 0, plans_refused = 0, transitions_solved = 0;
+  double verify_seconds = 0;
+  bool verifying = false;  // reported while the verifier runs
 };
 
 struct PlanningResult {

@@ -1,0 +1,123 @@
+#include "interpolator/plan_verifier.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <mutex>
+#include <thread>
+
+namespace acyclic {
+
+namespace {
+
+void appendBytes(std::string& key, const void* p, std::size_t n) { key.append(static_cast<const char*>(p), n); }
+
+// The exact contents of the stances a transition reads: its key.
+std::string transitionKey(const Plan& plan, const TransitionDesign& d) {
+  std::string key;
+  const int kind = static_cast<int>(d.kind);
+  appendBytes(key, &kind, sizeof kind);
+  for (int k = d.from; k <= d.to; ++k) {
+    const PlanStance& st = plan.stances[static_cast<std::size_t>(k)];
+    const Configuration& q = st.configuration;
+    appendBytes(key, q.base_position.data(), 3 * sizeof(double));
+    appendBytes(key, q.base_orientation.coeffs().data(), 4 * sizeof(double));
+    appendBytes(key, q.joints.data(), static_cast<std::size_t>(q.joints.size()) * sizeof(double));
+    const std::size_t n = st.contacts.size();
+    appendBytes(key, &n, sizeof n);
+    for (const PlanContact& c : st.contacts) {
+      const ContactSpec& s = c.spec;
+      const int ints[3] = {s.spot, s.surface, s.supporting ? 1 : 0};
+      const double place[3] = {s.placement.x, s.placement.y, s.placement.theta};
+      appendBytes(key, ints, sizeof ints);
+      appendBytes(key, place, sizeof place);
+    }
+  }
+  return key;
+}
+
+}  // namespace
+
+TransitionVerifier::TransitionVerifier(const Scenario& sc, const InterpolatorOptions& options)
+    : sc_(std::make_shared<const Scenario>(sc)), options_(transitionOptions(options)) {
+  for (int t = 0; t < std::max(1, options.threads); ++t)
+    solvers_.push_back(std::make_unique<TransitionSolver>(*sc_, options_));
+}
+
+PlanVerdict TransitionVerifier::verify(const Plan& plan, const std::atomic<bool>& stop) {
+  PlanVerdict v;
+  std::vector<int> kept;
+  for (int k = 0; k < static_cast<int>(plan.stances.size()); ++k) kept.push_back(k);
+  std::vector<TransitionDesign> designs;
+  if (std::string why = designTransitions(plan, kept, designs); !why.empty()) {
+    // Consecutive stances the planner wrote always differ by one contact: a
+    // plan the interpolator cannot design is the planner's bug.
+    throw std::logic_error("the plan's sequence cannot be interpolated: " + why);
+  }
+  v.transitions = static_cast<int>(designs.size());
+  const std::size_t nd = designs.size();
+  std::vector<std::string> keys(nd);
+  std::vector<Known> outcome(nd);
+  std::vector<char> have(nd, 0);
+  for (std::size_t i = 0; i < nd; ++i) {
+    keys[i] = transitionKey(plan, designs[i]);
+    const auto it = known_.find(keys[i]);
+    if (it != known_.end()) outcome[i] = it->second, have[i] = 1;
+  }
+  // The unknown ones, in order, on every solver; none after the first failure.
+  std::atomic<std::size_t> next{0}, first_failed{nd};
+  for (std::size_t i = 0; i < nd; ++i)
+    if (have[i] && !outcome[i].ok) {
+      first_failed = i;
+      break;
+    }
+  std::mutex m;
+  auto work = [&](TransitionSolver& s) {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= nd || i > first_failed.load() || stop.load()) return;
+      if (have[i]) continue;
+      const TransitionOutcome o = s.solve(plan, designs[i], &stop);
+      if (o.cancelled) return;
+      Known k{o.ok, o.reason};
+      if (!o.ok) {
+        std::size_t f = first_failed.load();
+        while (i < f && !first_failed.compare_exchange_weak(f, i)) {
+        }
+      }
+      std::lock_guard<std::mutex> lock(m);
+      outcome[i] = k;
+      have[i] = 1;
+      known_[keys[i]] = std::move(k);
+      ++v.solved;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < solvers_.size(); ++t) pool.emplace_back(work, std::ref(*solvers_[t]));
+  work(*solvers_[0]);
+  for (auto& th : pool) th.join();
+  for (std::size_t i = 0; i < nd; ++i) {
+    if (!have[i]) {
+      v.stopped = true;
+      return v;
+    }
+    if (!outcome[i].ok) {
+      v.failed_from = designs[i].from;
+      v.failed_to = designs[i].to;
+      v.reason = outcome[i].reason;
+      return v;
+    }
+  }
+  return v;
+}
+
+PlanVerifier makePlanVerifier(const Scenario& sc, const InterpolatorOptions& options) {
+  auto verifier = std::make_shared<TransitionVerifier>(sc, options);
+  return [verifier](const Plan& plan, const std::atomic<bool>& stop) { return verifier->verify(plan, stop); };
+}
+
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options) {
+  if (p.verify_transitions && !p.verify_plan) p.verify_plan = makePlanVerifier(sc, options);
+}
+
+}  // namespace acyclic

@@ -1,0 +1,48 @@
+#pragma once
+// The contact planner's lazy verification of transitions
+// (PlannerParameters::verify_transitions, docs/design.md section 7): every
+// transition of a plan the search found is solved as the interpolator will
+// solve it (same designs, every stance kept, same options), and the first
+// that cannot be made is reported, so that the search drops the stance it
+// leads to and goes on. A plan it accepts interpolates with those options.
+//
+// Transitions depend only on their stances: the outcome of each is
+// remembered, keyed by the stances' exact contents, so a plan that shares a
+// prefix with one already verified costs only its new transitions. Solved on
+// `threads` workers in order, the first failure in order reported: the
+// verdict does not depend on the thread count.
+#include <map>
+#include <memory>
+#include <string>
+
+#include "interpolator/interpolator.h"
+#include "planner/search/contact_planner.h"
+
+namespace acyclic {
+
+class TransitionVerifier {
+ public:
+  // Copies the scenario (the verifier outlives the caller's).
+  TransitionVerifier(const Scenario& sc, const InterpolatorOptions& options);
+  PlanVerdict verify(const Plan& plan, const std::atomic<bool>& stop);
+  std::size_t remembered() const { return known_.size(); }
+
+ private:
+  struct Known {
+    bool ok = false;
+    std::string reason;
+  };
+  std::shared_ptr<const Scenario> sc_;
+  TransitionOptions options_;
+  std::vector<std::unique_ptr<TransitionSolver>> solvers_;  // one per thread
+  std::map<std::string, Known> known_;
+};
+
+// A PlanVerifier for PlannerParameters::verify_plan around a shared
+// TransitionVerifier (the planner may copy it).
+PlanVerifier makePlanVerifier(const Scenario& sc, const InterpolatorOptions& options = {});
+
+// Gives p a verifier when p.verify_transitions is set and it has none.
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options = {});
+
+}  // namespace acyclic
