@@ -434,3 +434,41 @@ TEST(ContactPlanner, AVerificationPastTheTimeBudgetIsStoppedWithTheReason) {
   none.verify_transitions = true;
   EXPECT_THROW(ContactPlanner(step(), none), std::invalid_argument);
 }
+
+// A transition refused into a stance where a removal settles before an
+// addition (a foot lifted, before it lands) first gets that stance's next
+// witness candidate: the same path through the tree, exported again with
+// another witness there, and no node dropped.
+TEST(ContactPlanner, ARefusedTransitionIntoASettledStanceGetsItsNextWitnessFirst) {
+  const Scenario& sc = step();
+  const PlanningResult plain = ContactPlanner(sc).plan();
+  ASSERT_TRUE(plain.solved()) << plain.reason;
+  // step_forward: the start, a foot touching but no longer supporting (a
+  // removal), that foot gone (its settled stance, before the foot lands)...
+  ASSERT_GE(plain.plan.stances.size(), 4u);
+  ASSERT_EQ(plain.plan.stances[1].contacts.size(), 2u);
+  ASSERT_EQ(plain.plan.stances[2].contacts.size(), 1u);
+  const Configuration first = plain.plan.stances[2].configuration;
+  PlannerParameters p;
+  p.verify_transitions = true;
+  std::vector<Plan> seen;
+  p.verify_plan = [&](const Plan& plan, const std::atomic<bool>&) {
+    seen.push_back(plan);
+    PlanVerdict v;
+    if (plan.stances[2].configuration.joints == first.joints) {
+      v.failed_from = 1, v.failed_to = 2;
+      v.reason = "refused by the test";
+    }
+    return v;
+  };
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_EQ(r.stats.plans_refused, 1);
+  EXPECT_EQ(r.stats.nodes_generated, plain.stats.nodes_generated);  // nothing dropped, nothing searched anew
+  ASSERT_EQ(r.plan.stances.size(), plain.plan.stances.size());
+  EXPECT_NE(r.plan.stances[2].configuration.joints, first.joints);
+  for (std::size_t k = 0; k < r.plan.stances.size(); ++k)
+    if (k != 2) EXPECT_EQ(r.plan.stances[k].configuration.joints, plain.plan.stances[k].configuration.joints) << k;
+}

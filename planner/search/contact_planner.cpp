@@ -111,6 +111,9 @@ struct ContactPlanner::Impl {
     int depth = 0;                        // contact changes from the start (set by addNode)
     int changed_spot = -1;                // the spot of the contact added or removed from its parent
     bool dead = false;                    // no plan can be exported through it (exportPlan): not expanded
+    // The settled stance before it (settledWitness): the candidate used, and
+    // the first one allowed (raised when the verifier refuses the transition into it).
+    int settled_used = -1, settled_from = 0;
     std::vector<FailedPair> failed_pairs;  // first candidate failed here, or remembered from the parent
   };
   struct PairGenerator {
@@ -136,6 +139,7 @@ struct ContactPlanner::Impl {
   long order = 0;
   int goal_node = -1;
   std::vector<int> stance_owner;  // exportPlan: the node each stance of the plan comes from
+  std::vector<char> stance_settled;  // exportPlan: the stance is a settledWitness (its owner's settled_used)
   ContactPlanner::Progress progress;  // the caller's, also told when a verification starts
   const std::atomic<bool>* cancel = nullptr;  // checked before every posture call
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
@@ -685,8 +689,9 @@ struct ContactPlanner::Impl {
   // A witness for the stance `contacts` between a removal (witness `removed`)
   // and an addition (witness `added`), accepted by the independent check, or
   // none (see exportPlan).
+  // Candidates in order, from the `from`-th; `used` gets the one returned.
   std::optional<Configuration> settledWitness(const std::vector<ContactSpec>& contacts, const Configuration& added,
-                                              const Configuration& removed) {
+                                              const Configuration& removed, int from, int& used) {
     auto valid = [&](const Configuration& q) { return checker.checkPosture(q, contacts).valid(); };
     auto solve = [&](const Configuration& guess, PostureGenerator* generator) -> std::optional<Configuration> {
       PostureRequest r;
@@ -704,9 +709,16 @@ struct ContactPlanner::Impl {
       if (res.success() && valid(res.configuration)) return res.configuration;
       return std::nullopt;
     };
-    if (auto q = solve(added, nullptr)) return q;
-    if (auto q = solve(removed, nullptr)) return q;
-    if (valid(removed)) return removed;
+    used = 0;
+    if (from <= 0)
+      if (auto q = solve(added, nullptr)) return q;
+    used = 1;
+    if (from <= 1)
+      if (auto q = solve(removed, nullptr)) return q;
+    used = 2;
+    if (from <= 2 && valid(removed)) return removed;
+    used = 3;
+    if (from > 3) return std::nullopt;
     PostureGeneratorOptions patient = p.posture;
     patient.max_iterations = std::max(300, p.posture.max_iterations);
     patient.stop_at_restoration = false;  // the last resort: an answer whenever there is one
@@ -727,8 +739,10 @@ struct ContactPlanner::Impl {
     plan.scenario = sc.path;
     plan.robot = sc.robot->descriptionPath();
     stance_owner.clear();
+    stance_settled.clear();
     auto push = [&](const std::vector<ContactSpec>& specs, const Configuration& q, int owner) {
       stance_owner.push_back(owner);
+      stance_settled.push_back(0);
       PlanStance st;
       st.configuration = q;
       st.potential = keyOf(q);
@@ -760,12 +774,15 @@ struct ContactPlanner::Impl {
           // cur's, then from prev's; prev's own (the removed body may rest
           // on its surface's edge of validity); from cur's with a long
           // iteration budget. Without one no plan goes through cur.
-          std::optional<Configuration> settled = settledWitness(prev.contacts, cur.q, prev.q);
+          Node& owner = nodes[path[i]];
+          std::optional<Configuration> settled =
+              settledWitness(prev.contacts, cur.q, prev.q, owner.settled_from, owner.settled_used);
           if (!settled) {
-            nodes[path[i]].dead = true;
+            owner.dead = true;
             return false;
           }
           push(prev.contacts, *settled, path[i]);
+          stance_settled.back() = 1;
         }
       }
       push(cur.transition, cur.q, path[i]);
@@ -873,11 +890,27 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
           break;
         }
         ++I.stats.plans_refused;
-        const int owner = I.stance_owner.at(static_cast<std::size_t>(v.failed_to));
+        const auto to = static_cast<std::size_t>(v.failed_to);
+        const int owner = I.stance_owner.at(to);
+        // A transition into a settled stance (between a removal and an
+        // addition) first gets that stance's next witness candidate (the
+        // removal's own, nearer where the transition starts); the same goal is
+        // exported again. Without one left, the node is dropped.
+        // So does a transition out of a settled stance into its own node's
+        // transition stance (the settled witness is where the added body's
+        // motion starts).
+        const auto from = static_cast<std::size_t>(v.failed_from);
+        const bool settled_end =
+            I.stance_settled.at(to) || (I.stance_settled.at(from) && I.stance_owner.at(from) == owner);
+        const bool retry = settled_end && I.nodes[owner].settled_used < 3;
         if (I.p.trace)
           I.p.trace("verification: stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
                     " cannot be interpolated (" + v.reason.substr(0, 160) + "): node " + std::to_string(owner) +
-                    " dropped");
+                    (retry ? ": its settled stance's next witness" : " dropped"));
+        if (retry) {
+          I.nodes[owner].settled_from = I.nodes[owner].settled_used + 1;
+          continue;
+        }
         I.nodes[owner].dead = true;
       } else {
         ++I.stats.check_refusals;

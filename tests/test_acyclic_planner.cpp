@@ -1,0 +1,59 @@
+// acyclic-planner in file mode: by default each plan's transitions are
+// verified with the interpolator's solver before the plan is written (the
+// summary says so), the flags and the scenario key switch it, and bad input
+// is named.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "test_support.h"
+
+namespace {
+using acyclic::test::binaryPath;
+using acyclic::test::runProcess;
+using acyclic::test::sourcePath;
+
+acyclic::test::ProcessRun plan(const std::string& scenario, const std::string& out, const std::string& args = "") {
+  return runProcess(binaryPath("processes/acyclic-planner") + " -q --in " + scenario + " --out " + out + " " + args);
+}
+}  // namespace
+
+TEST(AcyclicPlanner, VerifiesThePlansTransitionsByDefaultAndNotWhenToldOtherwise) {
+  acyclic::test::TempDir dir;
+  const std::string s = sourcePath("models/scenarios/step_forward.yaml");
+  const auto on = plan(s, dir.path() + "/on.json");
+  ASSERT_EQ(on.status, 0) << on.output;
+  EXPECT_NE(on.output.find("transitions verified: 1 plans checked, 0 refused"), std::string::npos) << on.output;
+  // The plan it wrote interpolates: the interpolator's own run agrees.
+  const auto interp = runProcess(binaryPath("processes/acyclic-interpolator") + " --in " + dir.path() +
+                                 "/on.json --out " + dir.path() + "/t.json");
+  EXPECT_EQ(interp.status, 0) << interp.output;
+
+  const auto off = plan(s, dir.path() + "/off.json", "--no-verify-transitions");
+  ASSERT_EQ(off.status, 0) << off.output;
+  EXPECT_EQ(off.output.find("transitions verified"), std::string::npos) << off.output;
+  // The scenario's key switches it off too.
+  std::string text = acyclic::test::scenarioText("models/scenarios/step_forward.yaml");
+  ASSERT_EQ(text.find("\nplanner:"), std::string::npos);  // no planner section of its own
+  text += "\nplanner:\n  verify_transitions: false\n";
+  const auto keyed = plan(dir.write("s.yaml", text), dir.path() + "/keyed.json");
+  ASSERT_EQ(keyed.status, 0) << keyed.output;
+  EXPECT_EQ(keyed.output.find("transitions verified"), std::string::npos) << keyed.output;
+  // ... unless the command line says otherwise.
+  const auto forced = plan(dir.path() + "/s.yaml", dir.path() + "/forced.json", "--verify-transitions");
+  ASSERT_EQ(forced.status, 0) << forced.output;
+  EXPECT_NE(forced.output.find("transitions verified"), std::string::npos) << forced.output;
+}
+
+TEST(AcyclicPlanner, ContradictoryFlagsAndABadKeyAreBadInput) {
+  acyclic::test::TempDir dir;
+  const std::string s = sourcePath("models/scenarios/step_forward.yaml");
+  const auto both = plan(s, dir.path() + "/p.json", "--verify-transitions --no-verify-transitions");
+  EXPECT_EQ(both.status, 2) << both.output;
+  std::string text = acyclic::test::scenarioText("models/scenarios/step_forward.yaml");
+  text += "\nplanner:\n  verify_transitions: sometimes\n";
+  const auto bad = plan(dir.write("bad.yaml", text), dir.path() + "/p.json");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("verify_transitions"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/p.json"));
+}
