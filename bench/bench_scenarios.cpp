@@ -1,7 +1,9 @@
 // Every scenario shipped in models/scenarios planned by the full planner, one
 // after the other in one run: result, wall time, nodes, posture calls and
 // failures, plan length, the non-foot contacts the plan uses, and the
-// independent check's verdict on the plan.
+// independent check's verdict on the plan. A scenario without key postures
+// is guided by the OMPL author first (planner/guide/guide_author.h); its
+// time is in the wall time.
 // Usage: bench_scenarios [SCENARIO...] [OPTIONS]   (default: every shipped scenario); --help lists the options.
 #include <algorithm>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "interpolator/plan_verifier.h"
 #endif
 #include "planner/check/plan_check.h"
+#include "planner/guide/guide_author.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/search/planner_parameters.h"
 
@@ -48,7 +51,19 @@ int main(int argc, char** argv) {
   std::printf("%-14s %-16s %9s %7s %7s %7s %8s %-7s %s\n", "scenario", "result", "seconds", "nodes", "calls",
               "failed", "stances", "check", "non-foot contacts used");
   for (const auto& path : paths) {
-    const Scenario sc = Scenario::load(path);
+    Scenario sc = Scenario::load(path);
+    double guide_seconds = 0;
+    const bool guided = sc.key_postures.size() < 2;
+    if (guided) {
+      const GuideResult g = authorGuide(sc, GuideOptions());
+      guide_seconds = g.goal_seconds + g.path_seconds;
+      if (!g.success()) {
+        std::printf("%-14s %-16s %9.2f  the OMPL guide author: %s\n", sc.name.c_str(), "no guide", guide_seconds,
+                    g.reason.c_str());
+        continue;
+      }
+      sc.key_postures = g.guide.key_postures;
+    }
     PlannerParameters p = plannerParameters(sc);
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (verify) p.verify_transitions = true;
@@ -69,8 +84,11 @@ int main(int argc, char** argv) {
       for (const auto& n : names) used += (used.empty() ? "" : " ") + n;
     }
     std::printf("%-14s %-16s %9.2f %7ld %7ld %7ld %8zu %-7s %s\n", sc.name.c_str(), toString(r.status),
-                r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures,
+                guide_seconds + r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures,
                 r.plan.stances.size(), verdict.c_str(), used.empty() ? "none" : used.c_str());
+    if (guided)
+      std::printf("%-14s   guided by the OMPL author: %zu key postures in %.2f s\n", "", sc.key_postures.size(),
+                  guide_seconds);
     if (r.stats.plans_verified > 0)
       std::printf("%-14s   transitions verified: %ld plans, %ld refused, %ld transitions solved, %.2f s of the %.2f s\n",
                   "", r.stats.plans_verified, r.stats.plans_refused, r.stats.transitions_solved,

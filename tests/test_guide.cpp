@@ -12,6 +12,7 @@
 #include "planner/guide/guide_author.h"
 #include "planner/search/contact_planner.h"
 #include "planner/search/guide_potential.h"
+#include "planner/search/planner_parameters.h"
 #include "test_support.h"
 
 using namespace acyclic;
@@ -153,14 +154,14 @@ TEST(GuideAuthor, ACrouchOnTheFeetEndsLoweredOnTheStartStance) {
 }
 
 TEST(GuideAuthor, AGoalBeyondAStepsEdgeEndsStandingOnTheStep) {
-  // tests/data/step_up_scene.yaml: a platform 0.15 m high, its edge 0.35 m
+  // models/scenes/step_up.yaml: a platform 0.15 m high, its edge 0.35 m
   // ahead; the goal is the waist 0.75 m ahead, over the platform. Standing on
   // the floor there puts the feet inside the platform: the guide ends
   // standing on its top, both feet on it, a stance the check accepts.
   test::TempDir dir;
   const std::string text = "format: acyclic.scenario/1\nname: step_up\nrobot: " +
                            test::sourcePath("models/hrp2/hrp2.yaml") + "\nscene: " +
-                           test::sourcePath("tests/data/step_up_scene.yaml") +
+                           test::sourcePath("models/scenes/step_up.yaml") +
                            "\nstart:\n  configuration: {posture: half_sitting}\n  contacts:\n"
                            "    - {spot: r_sole, surface: floor}\n    - {spot: l_sole, surface: floor}\n"
                            "allowed_spots: [r_sole, l_sole, r_palm]\nallowed_surfaces: [floor, platform_top, wall_face]\n"
@@ -265,4 +266,39 @@ TEST(GuideFile, RoundTripAndNamedErrors) {
   } catch (const FormatError& e) {
     EXPECT_EQ(e.field(), "format");
   }
+}
+
+// models/scenarios/step_up.yaml, with no key postures: the guide's base stays
+// within the standing height (plus the slack) of the ground within a step of
+// it, so it rises only where a foot can go up on the platform, and the
+// planner climbs it on that guide. A guide that floats up before the edge
+// (no ceiling) leaves the planner nowhere to go.
+TEST(GuideAuthor, AStepUpIsGuidedUnderTheCeilingAndPlannedOntoThePlatform) {
+  Scenario sc = Scenario::load(test::sourcePath("models/scenarios/step_up.yaml"));
+  ASSERT_TRUE(sc.key_postures.empty());
+  const GuideResult g = authorGuide(sc, GuideOptions());
+  ASSERT_TRUE(g.success()) << g.reason;
+  const double standing = sc.robot->posture("half_sitting").base_position.z();  // soles at z = 0
+  for (const auto& q : g.guide.key_postures)
+    if (q.base_position.x() < 0.35 - 0.25 - 1e-6)  // no platform within a step: the floor's ceiling
+      EXPECT_LE(q.base_position.z(), standing + GuideOptions().ceiling_slack + 1e-9) << q.base_position.transpose();
+  sc.key_postures = g.guide.key_postures;
+  PlannerParameters p = plannerParameters(sc);
+  p.max_nodes = 200;  // solved in 24: a node budget, not the machine's speed, bounds a failing run
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checkPlan(r.plan, sc, checker).valid());
+  int on_platform = 0;
+  for (const auto& c : r.plan.stances.back().contacts)
+    on_platform += c.spec.supporting && sc.scene->surfaces()[c.spec.surface].name == "platform_top";
+  EXPECT_EQ(on_platform, 2);
+
+  // Without the ceiling the guide rises before the edge and the search fails.
+  GuideOptions free;
+  free.ceiling_slack = 10;
+  const GuideResult floating = authorGuide(sc, free);
+  ASSERT_TRUE(floating.success()) << floating.reason;
+  sc.key_postures = floating.guide.key_postures;
+  EXPECT_FALSE(ContactPlanner(sc, p).plan().solved());
 }

@@ -63,13 +63,55 @@ struct Lift {
 
 // Valid: every robot-environment pair at least -penetration apart. Self
 // pairs are left out: the joints blend between two valid postures.
+// The ground under a point: the highest surface the scenario allows whose
+// outward normal is within 45 degrees of straight up and whose polygon holds
+// the point's vertical projection (its plane's height there); none: nullopt.
+std::optional<double> groundUnder(const Scenario& sc, double x, double y) {
+  std::optional<double> best;
+  for (int si : sc.allowed_surfaces) {
+    const Surface& surf = sc.scene->surfaces()[si];
+    const Eigen::Vector3d n = surf.frame.linear().col(2), o = surf.frame.translation();
+    if (n.z() < std::cos(M_PI / 4)) continue;
+    const double z = o.z() - (n.x() * (x - o.x()) + n.y() * (y - o.y())) / n.z();
+    const Eigen::Vector3d local = surf.frame.inverse() * Eigen::Vector3d(x, y, z);
+    if (!surf.polygon.contains(local.head<2>())) continue;
+    if (!best || z > *best) best = z;
+  }
+  return best;
+}
+
+// Valid: every robot-environment pair at least -penetration apart, and,
+// with a ceiling, the base no higher above the ground within a step of it
+// than the ceiling (a robot can raise its base above what it stands on only by its
+// standing height: a path that floats up before it reaches a step gives the
+// planner a valley no stance can follow). Self pairs are left out: the
+// joints blend between two valid postures.
 class RelaxedValidity : public ob::StateValidityChecker {
  public:
   RelaxedValidity(const ob::SpaceInformationPtr& si, const Scenario& sc, const Lift& lift, double penetration)
-      : ob::StateValidityChecker(si), lift_(lift), kin_(sc.robot), collision_(sc.robot, sc.scene),
+      : ob::StateValidityChecker(si), sc_(sc), lift_(lift), kin_(sc.robot), collision_(sc.robot, sc.scene),
         penetration_(penetration) {}
+  void setCeiling(double above_ground) { ceiling_ = above_ground; }
+  // The base's height above the ground within a step of it (the highest
+  // under its point and the corners and edge middles of a square 2 kStep
+  // wide around it: a foot put up there lets the base rise); nullopt: no ground.
+  std::optional<double> heightAboveGround(const double* s) const {
+    constexpr double kStep = 0.25;  // m
+    std::optional<double> g;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j) {
+        const auto h = groundUnder(sc_, s[0] + i * kStep, s[1] + j * kStep);
+        if (h && (!g || *h > *g)) g = h;
+      }
+    if (!g) return std::nullopt;
+    return s[2] - *g;
+  }
   bool isValid(const ob::State* state) const override {
     const double* s = state->as<ob::RealVectorStateSpace::StateType>()->values;
+    if (ceiling_) {
+      const auto h = heightAboveGround(s);
+      if (h && *h > *ceiling_) return false;
+    }
     kin_.setConfiguration(lift_(s));
     DistanceOptions o;
     o.cutoff = 0.0;  // only pairs whose bounding volumes may touch
@@ -80,10 +122,12 @@ class RelaxedValidity : public ob::StateValidityChecker {
   }
 
  private:
+  const Scenario& sc_;
   const Lift& lift_;
   mutable Kinematics kin_;
   CollisionModel collision_;
   double penetration_;
+  std::optional<double> ceiling_;
 };
 
 // Each contact placed where kin holds its spot, supporting; false if one
@@ -356,6 +400,24 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     out.status = GuideResult::Status::NoGoalPosture;
     out.reason = "the goal posture penetrates the scene";
     return out;
+  }
+  // The ceiling: the standing posture's base height over its soles, plus
+  // GuideOptions::ceiling_slack, when the start and the goal are both under it.
+  if (sc.robot->postures().count(o.standing_posture)) {
+    Kinematics kin(sc.robot);
+    const Configuration standing = sc.robot->posture(o.standing_posture);
+    kin.setConfiguration(standing);
+    double soles = std::numeric_limits<double>::infinity();
+    for (const char* name : {"r_sole", "l_sole"})
+      if (sc.robot->spotIndex(name) >= 0) soles = std::min(soles, kin.spotPose(sc.robot->spotIndex(name)).translation().z());
+    if (std::isfinite(soles)) {
+      const double ceiling = standing.base_position.z() - soles + o.ceiling_slack;
+      auto under = [&](const double* v) {
+        const auto h = validity->heightAboveGround(v);
+        return !h || *h <= ceiling;
+      };
+      if (under(sv) && under(gv)) validity->setCeiling(ceiling);
+    }
   }
   ss.setStartAndGoalStates(start, target);
   auto planner = std::make_shared<SeededRRTConnect>(si, seed);
