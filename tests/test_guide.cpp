@@ -302,3 +302,45 @@ TEST(GuideAuthor, AStepUpIsGuidedUnderTheCeilingAndPlannedOntoThePlatform) {
   sc.key_postures = floating.guide.key_postures;
   EXPECT_FALSE(ContactPlanner(sc, p).plan().solved());
 }
+
+// Sitting down at a table: HRP-2 stands beside the chair of
+// models/scenes/chair_table.yaml, whose seat is 6 cm from the table's edge.
+// Carried toward the seat, the start stance meets the table or the seat's
+// side; the seated posture put over the seat, resting on the thighs, then the
+// soles floated down to the floor, is a goal posture the check accepts.
+TEST(GuideAuthor, SittingDownAtATableEndsOnTheSeatedPostureOverTheSeat) {
+  test::TempDir dir;
+  const std::string text = "format: acyclic.scenario/1\nname: sit_at_table\nrobot: " +
+                           test::sourcePath("models/hrp2/hrp2.yaml") + "\nscene: " +
+                           test::sourcePath("models/scenes/chair_table.yaml") +
+                           "\nstart:\n  configuration: {posture: half_sitting, base_position: [0.0, 0.85, 0.648702]}\n"
+                           "  contacts:\n    - {spot: r_sole, surface: floor}\n    - {spot: l_sole, surface: floor}\n"
+                           "allowed_spots: [r_sole, l_sole, r_thigh, l_thigh, r_wrist, l_wrist]\n"
+                           "allowed_surfaces: [floor, chair_seat, table_top]\n"
+                           "goal: {link: WAIST, axis: z, max: 0.40, supported_by: [r_thigh, l_thigh]}\n";
+  const Scenario sc = Scenario::load(dir.write("sit_at_table.yaml", text));
+  GuideResult r;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, r));
+  const Configuration& end = r.guide.key_postures.back();
+  std::vector<ContactSpec> seated(4);
+  const char* spots[] = {"r_sole", "l_sole", "r_thigh", "l_thigh"};
+  for (int k = 0; k < 4; ++k) {
+    seated[k].spot = sc.robot->spotIndex(spots[k]);
+    seated[k].surface = sc.scene->surfaceIndex(k < 2 ? "floor" : "chair_seat");
+  }
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(end);
+  placeOnSurfaces(sc, kin, seated);
+  EXPECT_TRUE(sc.goal.satisfied(kin, seated));
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checker.checkPosture(end, seated).valid());
+  // Over the seat (x in [-0.18, 0.16], y in [-0.21, 0.21]), facing the table.
+  EXPECT_NEAR(end.base_position.y(), 0.0, 0.21);
+  EXPECT_LT(end.base_position.x(), 0.16);
+  // Without the seated posture the author has no goal posture: the start
+  // stance carried toward the seat cannot sit on it.
+  GuideOptions none;
+  none.seated_posture = "no such posture";
+  const GuideResult without = authorGuide(sc, none);
+  EXPECT_EQ(without.status, GuideResult::Status::NoGoalPosture) << without.reason;
+}

@@ -63,6 +63,9 @@ struct Lift {
 
 // Valid: every robot-environment pair at least -penetration apart. Self
 // pairs are left out: the joints blend between two valid postures.
+// A surface whose outward normal is within 10 degrees of straight up: one to stand on.
+constexpr double kLevelSurface = 0.985;
+
 // The ground under a point: the highest surface the scenario allows whose
 // outward normal is within 45 degrees of straight up and whose polygon holds
 // the point's vertical projection (its plane's height there); none: nullopt.
@@ -254,6 +257,88 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
   return false;
 }
 
+// A seated posture resting on the goal's supports, for a seat at a table
+// (where the start stance carried toward the seat meets the table): the
+// robot's seated posture (GuideOptions::seated_posture) turned to the start's
+// heading, the supports' middle put over the middle of a level surface they
+// may rest on (then 5 and 10 cm back and forth along the heading); first
+// resting on the supports alone, then each other start contact (a sole) added
+// floating over its surface, touching, as the planner adds one; then the
+// whole stance supporting, accepted by the check and in the goal.
+bool goalPostureSeated(const Scenario& sc, const GuideOptions& o, PostureGenerator& pg, ValidityChecker& checker,
+                       Kinematics& kin, Configuration& out) {
+  const RobotModel& m = *sc.robot;
+  const GoalCondition& g = sc.goal;
+  if (g.supporting_spots.empty() || !m.postures().count(o.seated_posture)) return false;
+  Configuration seated = m.posture(o.seated_posture);
+  const double yaw = yawOf(sc.start.base_orientation);
+  seated.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  seated.base_position.head<2>() = sc.start.base_position.head<2>();
+  kin.setConfiguration(seated);
+  Eigen::Vector3d supports = Eigen::Vector3d::Zero();
+  for (int s : g.supporting_spots) supports += kin.spotPose(s).translation();
+  supports /= static_cast<double>(g.supporting_spots.size());
+  const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
+  std::vector<ContactSpec> others;  // the start's contacts that are not the goal's supports
+  for (const auto& c : sc.start_stance)
+    if (std::find(g.supporting_spots.begin(), g.supporting_spots.end(), c.spot) == g.supporting_spots.end())
+      others.push_back(c);
+  for (int si : sc.allowed_surfaces) {
+    const Surface& surf = sc.scene->surfaces()[si];
+    bool start_surface = false;
+    for (const auto& c : sc.start_stance) start_surface = start_surface || c.surface == si;
+    if (start_surface || surf.frame.linear().col(2).z() < kLevelSurface) continue;
+    const Eigen::Vector2d centroid = surf.polygon.centroid();
+    const Eigen::Vector3d middle = surf.frame * Eigen::Vector3d(centroid.x(), centroid.y(), 0);
+    for (double d : {0.0, -0.05, 0.05, -0.1, 0.1}) {
+      Configuration q = seated;
+      q.base_position += middle - supports;
+      q.base_position.head<2>() += d * heading;
+      kin.setConfiguration(q);
+      std::vector<ContactSpec> stance;
+      for (int s : g.supporting_spots) {
+        ContactSpec c;
+        c.spot = s;
+        c.surface = si;
+        stance.push_back(c);
+      }
+      if (!placeWhereHeld(sc, kin, stance)) continue;
+      PostureRequest r;
+      r.contacts = stance;
+      r.initial_guess = q;
+      r.cost = std::make_shared<ReferencePostureCost>(q, 0.01, 10.0, 1.0);
+      const PostureResult res = pg.solve(r);
+      if (!res.success()) continue;
+      Configuration at = res.configuration;
+      bool added = true;
+      for (const auto& other : others) {
+        const Surface& on = sc.scene->surfaces()[other.surface];
+        PostureRequest a;
+        a.contacts = stance;
+        a.initial_guess = at;
+        FloatingContact f;
+        f.spot = other.spot;
+        f.surface = other.surface;
+        f.volume.polygon = on.polygon;
+        a.floating = f;
+        const PostureResult ar = pg.solve(a);
+        if (!ar.success()) {
+          added = false;
+          break;
+        }
+        at = ar.configuration;
+        kin.setConfiguration(at);
+        ContactSpec c = other;
+        c.supporting = false;
+        c.placement = projectOnSurface(on, kin.spotPose(other.spot));
+        stance.push_back(c);
+      }
+      if (added && solveGoalStance(sc, pg, checker, kin, at, stance, out)) return true;
+    }
+  }
+  return false;
+}
+
 // A posture in the goal region. First standing: the named standing posture
 // moved there, feet put on the start's floor surface or on a level surface
 // above it (standingSurfaces). Failing that (a robot
@@ -262,8 +347,6 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
 // start contact put on its surface where the moved posture holds its spot.
 // Each through the posture generator and the independent check, the free
 // horizontal coordinate tried around the start's, nearest first.
-// A surface whose outward normal is within 10 degrees of straight up: one to stand on.
-constexpr double kLevelSurface = 0.985;
 
 bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, std::string& why) {
   const RobotModel& m = *sc.robot;
@@ -289,10 +372,12 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
   ValidityChecker checker(sc.robot, sc.scene);
   if (g.axis == 2) {  // a height: nothing to carry along; only a posture on the goal's supports
     if (goalPostureOnSupports(sc, o, pg, checker, kin, out)) return true;
+    if (goalPostureSeated(sc, o, pg, checker, kin, out)) return true;
     why = g.supporting_spots.empty()
               ? "a goal on the vertical axis needs supported_by: the guide author rests the robot on those spots"
               : "no valid posture resting on the goal's supports found in the goal region (" + g.describe(m) +
-                    ") in " + std::to_string(o.support_attempts) + " placements";
+                    ") in " + std::to_string(o.support_attempts) + " placements of the start stance, nor with the '" +
+                    o.seated_posture + "' posture over a level surface they may rest on";
     return false;
   }
   Configuration standing = m.posture(o.standing_posture);

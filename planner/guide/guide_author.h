@@ -27,6 +27,10 @@ struct GuideOptions {
   double goal_search = 0.6;     // m: the goal posture's free coordinate tried within +- this of the start's
   int support_attempts = 40;    // start stances carried toward a surface, for a goal posture on supported_by spots
   std::string standing_posture = "half_sitting";  // the robot's named posture the goal posture starts from
+  // For a goal resting on supported_by spots that the start stance carried
+  // toward their surface cannot reach (a seat at a table): the robot's named
+  // seated posture put over that surface (goalPosture).
+  std::string seated_posture = "sitting";
   // m: the path's base at most this much higher over the ground under it
   // than the standing posture's base over its soles (authorGuide).
   double ceiling_slack = 0.03;
