@@ -114,8 +114,13 @@ LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int
     return clearanceAt(collisions, kin, pairs, q, o.clearance);
   };
   // Each end as close as its witness has it.
-  const double c0 = clearance(a0, 0), c1 = clearance(a1, 1);
-  if (!(std::min(c0, c1) > 1e-3)) {
+  double c0 = clearance(a0, 0), c1 = clearance(a1, 1);
+  if (o.touching_ends) {
+    constexpr double kTouch = -1e-4;
+    if (c0 <= 1e-3 && c0 >= kTouch) c0 = kTouch;
+    if (c1 <= 1e-3 && c1 >= kTouch) c1 = kTouch;
+  }
+  if (!o.touching_ends && !(std::min(c0, c1) > 1e-3)) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "the limb's path cannot be planned: its %s witness has it within 1 mm of an obstacle or another link",
                   c0 <= c1 ? "first" : "last");

@@ -55,6 +55,12 @@ struct LimbPathPlanOptions {
   // this much per radian of the largest joint change from it.
   double clearance_per_rad = 0.1;
   long max_checks = 20000;     // OMPL's budget, in states checked (not time: the same path under any load)
+  // The limb's own body rests on a surface at the ends (a forearm lifted off
+  // a table, then swung around its edge): an end within 1 mm of an obstacle
+  // is then taken as touching (clearance 0, less 0.1 mm of the contact's
+  // tolerance), and the clearance asked for rises from there as the limb
+  // moves away. Otherwise such an end has no path.
+  bool touching_ends = false;
   unsigned seed = 1;
 };
 

@@ -126,6 +126,8 @@ struct TransitionSolver::Attempt {
   std::string reason;
   bool cancelled = false;
   std::vector<MotionPiece> pieces;
+  // The moving body off its path, as a pendulum's (solve(), last stage).
+  bool free_body = false;
 };
 
 struct TransitionSolver::FreeEnd {
@@ -421,6 +423,31 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
           std::any_of(planned.begin(), planned.end(), [](const FreeEnd& f) { return f.joints.has_value(); });
       if (planned_joints) out.ok = tryPaths(&planned, "with the free limbs' joints planned, ");
     }
+    // Last, a body on a limb that holds no other contact (a forearm lifted
+    // off the table, the hand beyond it free) leaves its path: held only where
+    // it touches (as a foot hanging from its thigh, hangsFromItsLimb), its
+    // limb's joints on their interpolation between the witnesses, or planned
+    // around what that sweeps them through, the other free limbs as in the
+    // stage before. A forearm's pose along a spline between two witnesses
+    // that turn it about the elbow asks the shoulder for places the seated
+    // trunk cannot give (a chair plan: no posture at 0.3 of the path,
+    // whichever via-point).
+    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths && opt_.limb_joint_paths &&
+        onFreeLimb(d)) {
+      std::vector<FreeEnd> limbs = withPlannedJoints(plan, d, freeEnds(plan, d));
+      const Configuration& q0 = plan.stances[d.from].configuration;
+      const Configuration& q1 = plan.stances[d.to].configuration;
+      const int root = sc_.robot->spotLimbRootJoint(d.spot);
+      std::optional<LimbJointPath> own = plannedLimbJoints(q0, q1, root, true);
+      if (!own) own = straightLimbJoints(q0, q1, root);
+      limbs.push_back({d.spot, BodyPath(e0, e0, 0), std::move(own)});
+      at.pieces.clear();
+      at.free_body = true;
+      out.ok = solveMove(plan, d, BodyPath(e0, e1, 2 * kPendulumTouch), opt_.air_orientation_tolerance, &limbs, at);
+      at.free_body = false;
+      out.repaired = out.ok;
+      if (!out.ok && !at.cancelled) reasons += "; the body free in the air, its limb's joints interpolated: " + at.reason;
+    }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
   }
@@ -484,7 +511,10 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
     r.initial_guess = guess;
     Configuration ref = lerp(q0, q1, alpha);
     for (const auto& l : limbs) ref = l.apply(ref, alpha);
-    r.cost = std::make_shared<ReferencePostureCost>(follow ? lerp(guess, ref, 0.5) : ref);
+    // Planned limbs on their paths even when following the previous knot (solveMove).
+    Configuration target = follow ? lerp(guess, ref, 0.5) : ref;
+    for (const auto& l : limbs) target = l.apply(target, alpha);
+    r.cost = std::make_shared<ReferencePostureCost>(target);
     PostureResult res = generator.solve(r);
     ++at.posture_calls;
     at.posture_seconds += res.seconds;
@@ -603,11 +633,37 @@ std::vector<int> TransitionSolver::freeLimbEnds(const TransitionDesign& d) const
 // the planner's clearance: the posture generator's margin is kept by knots
 // that hug an obstacle, and the interpolation between them dips below it).
 std::optional<LimbJointPath> TransitionSolver::plannedLimbJoints(const Configuration& q0, const Configuration& q1,
-                                                                 int root) {
-  const LimbPathPlanOptions lo;
+                                                                 int root, bool touching_ends) {
+  LimbPathPlanOptions lo;
+  lo.touching_ends = touching_ends;
   if (limbSweepClearance(collisions_, kin_, root, q0, q1, lo.clearance) >= 0.5 * lo.clearance) return std::nullopt;
-  LimbPathPlan planned = planLimbPath(collisions_, kin_, root, q0, q1, lo);
-  return std::move(planned.path);
+  // Narrower where the limb must pass a gap (a forearm between a table's
+  // edge and the trunk, 5 mm from the edge in both witnesses: no path 10 mm
+  // clear, one 3 mm clear); the knots keep the posture generator's margin
+  // around it and every sample is checked.
+  for (double clearance : {lo.clearance, 0.005, 0.003}) {
+    lo.clearance = clearance;
+    LimbPathPlan planned = planLimbPath(collisions_, kin_, root, q0, q1, lo);
+    if (planned.path) return std::move(planned.path);
+  }
+  return std::nullopt;
+}
+
+LimbJointPath TransitionSolver::straightLimbJoints(const Configuration& q0, const Configuration& q1, int root) const {
+  const std::vector<int> joints = sc_.robot->jointsMovedBy(root);
+  Eigen::VectorXd a(joints.size()), b(joints.size());
+  for (std::size_t k = 0; k < joints.size(); ++k) a[k] = q0.joints[joints[k]], b[k] = q1.joints[joints[k]];
+  return LimbJointPath(joints, {a, b}, {0.0, 1.0});
+}
+
+bool TransitionSolver::onFreeLimb(const TransitionDesign& d) const {
+  if (d.kind != TransitionDesign::Kind::Move || d.spot < 0) return false;
+  const RobotModel& m = *sc_.robot;
+  const int root = m.spotLimbRootJoint(d.spot);
+  if (root < 0) return false;
+  for (const auto& c : d.motion_contacts)
+    if (m.spotLimbRootJoint(c.spot) == root) return false;
+  return true;
 }
 
 std::vector<PlacedShape> TransitionSolver::outsideLimb(const Configuration& q, int spot) {
@@ -628,7 +684,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
   std::vector<int> touch;
   if (d.leave) touch.push_back(sc_.scene->surfaces()[d.leave->surface].obstacle);
   if (d.arrive) touch.push_back(sc_.scene->surfaces()[d.arrive->surface].obstacle);
-  const bool pendulum = hangsFromItsLimb(d);
+  const bool pendulum = hangsFromItsLimb(d) || at.free_body;
   const double touch_clearance = pendulum ? kPendulumTouch : opt_.touch_clearance;
   const double s0 = path.leaveParameter(touch_clearance), s1 = path.arriveParameter(touch_clearance);
   bool loose_only = false;
@@ -651,7 +707,16 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
         else
           free_targets.push_back({f.spot, f.path.pose(s).translation(), opt_.free_limb_weight});
       }
-    const auto cost = std::make_shared<ReferencePostureCost>(lerp(guess, ref, 0.5), 1.0, 10.0, 1.0, free_targets);
+    // A limb whose joints were planned follows its path, not halfway to the
+    // previous knot: that half lagged the arm behind its path until the
+    // optimum jumped to the far side of the table's edge between two knots
+    // (0.12 rad at s = 0.4008 of a chair plan's transition), which no
+    // refinement closes. Its path is continuous in s already.
+    Configuration target = lerp(guess, ref, 0.5);
+    if (free_ends)
+      for (const auto& f : *free_ends)
+        if (f.joints) target = f.joints->apply(target, s);
+    const auto cost = std::make_shared<ReferencePostureCost>(target, 1.0, 10.0, 1.0, free_targets);
     auto attempt = [&](const PoseTarget& t, const Configuration& g) {
       PostureRequest r;
       r.contacts = d.motion_contacts;

@@ -40,9 +40,13 @@
 // pulled along a path of its own between its witness positions, where the
 // witnesses' interpolation swings it into an obstacle, or, where the limb's
 // interpolated joints sweep it through one (an elbow through a table's edge),
-// with those joints planned with OMPL (limb_path_planner.h). A Move whose
-// body touches its surface in both witnesses is solved as a Fixed one that
-// holds it there.
+// with those joints planned with OMPL (limb_path_planner.h; 10 mm clear,
+// else 5 or 3 mm through a narrow gap), the knots' target on each planned
+// limb its path itself. Last, a body on a limb that holds no other contact
+// (a forearm off a table, its arm free) leaves its path: held only where it
+// touches, as a foot hanging from its thigh, its limb's joints planned from
+// touching (or interpolated). A Move whose body touches its surface in both
+// witnesses is solved as a Fixed one that holds it there.
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -165,7 +169,13 @@ class TransitionSolver {
   // The joints `root` moves (a limb, or what lies beyond the moving body in
   // its limb) planned from q0's to q1's where their interpolation sweeps
   // them into an obstacle; none where it does not, or no path was found.
-  std::optional<LimbJointPath> plannedLimbJoints(const Configuration& q0, const Configuration& q1, int root);
+  // `touching_ends`: LimbPathPlanOptions::touching_ends (the limb's own body on its surface).
+  std::optional<LimbJointPath> plannedLimbJoints(const Configuration& q0, const Configuration& q1, int root,
+                                                 bool touching_ends = false);
+  // The joints `root` moves on their straight interpolation from q0's to q1's.
+  LimbJointPath straightLimbJoints(const Configuration& q0, const Configuration& q1, int root) const;
+  // Whether the Move's body is on a limb that holds no contact during the motion (a forearm, its arm free).
+  bool onFreeLimb(const TransitionDesign& d) const;
   // A Move whose body already touches its surface in both witnesses, as the
   // Fixed transition that holds it touching; none for any other.
   std::optional<TransitionDesign> stillBody(const Plan& plan, const TransitionDesign& d);

@@ -348,6 +348,43 @@ TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEach
   EXPECT_NE(n.reason.find("no path"), std::string::npos) << n.reason;
 }
 
+TEST(LimbPathPlanner, AForearmOnTheTableIsTouchingAtItsEndOnlyWhenToldSo) {
+  // From a plan of the paper's chair: seated on the left thigh, the left
+  // forearm leaves the table, and the arm hangs below the table's top in the
+  // next witness. The forearm rests on the top at the first end: no path by
+  // default (an end within 1 mm of an obstacle); with touching ends, one that
+  // rises from the top and clears it, then the table, along the way.
+  const Scenario& sc = paperChairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_paper_forearm_off_table.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  const Configuration& q0 = plan.stances[0].configuration;
+  const Configuration& q1 = plan.stances[1].configuration;
+  const CollisionModel collisions(sc.robot, sc.scene);
+  Kinematics kin(sc.robot);
+  const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_forearm"));
+  EXPECT_LT(limbSweepClearance(collisions, kin, root, q0, q1, 0.01), -0.1);  // the interpolation cuts the table
+  const LimbPathPlan plain = planLimbPath(collisions, kin, root, q0, q1);
+  EXPECT_FALSE(plain.path);
+  EXPECT_NE(plain.reason.find("within 1 mm"), std::string::npos) << plain.reason;
+  LimbPathPlanOptions touching;
+  touching.touching_ends = true;
+  const LimbPathPlan p = planLimbPath(collisions, kin, root, q0, q1, touching);
+  ASSERT_TRUE(p.path) << p.reason;
+  EXPECT_GT(p.path->waypoints().size(), 2u);
+  // Between its waypoints, as planned (the body at the path's own progress):
+  // never into the table by more than the contact's 0.1 mm.
+  double worst = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= 400; ++i) {
+    const double s = i / 400.0;
+    kin.setConfiguration(p.path->apply(lerp(q0, q1, s), s));
+    for (const auto& d : collisions.distances(kin))
+      if (collisions.pairs()[d.pair].kind == CollisionPair::Kind::RobotEnvironment &&
+          sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_a))
+        worst = std::min(worst, d.distance);
+  }
+  EXPECT_GT(worst, -2e-4);
+}
+
 TEST(LimbJointPath, InterpolatesBetweenWaypointsAtTheirProgress) {
   const LimbJointPath p({3, 5}, {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 2)}, {0, 0.25, 1});
   EXPECT_TRUE(p.at(-1).isApprox(Eigen::Vector2d(0, 0)));
@@ -763,11 +800,21 @@ TEST(Interpolator, FootPassesBetweenTheChairLegAndTheOtherFootOnAPlannedPath) {
   // foot 0.138 m wide. Every spline cuts the leg or the other foot, or leaves
   // the foot's turn to the knots, which turn its toes one way and then the
   // other (a hip yaw jump of 0.4 rad between two knots 2 mm apart); the
-  // path planned with OMPL turns the foot with the gap.
+  // path planned with OMPL turns the foot with the gap. (Without that path,
+  // and without planned limb joints, it fails.)
   const Scenario& sc = chairScenario();
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_step.plan.json"), sc);
   ASSERT_EQ(plan.stances.size(), 3u);
-  expectRepairedOnlyWith(plan, sc, [](InterpolatorOptions& o) { o.plan_body_path = false; }, "stances 0 -> 2");
+  expectRepairedOnlyWith(
+      plan, sc, [](InterpolatorOptions& o) { o.plan_body_path = false, o.limb_joint_paths = false; }, "stances 0 -> 2");
+  // Without the body's path but with the stages after it (planned limb
+  // joints, then the foot free in the air on its leg's joints), it passes too.
+  InterpolatorOptions no_body_path;
+  no_body_path.filter = false;
+  no_body_path.plan_body_path = false;
+  const InterpolationResult r = interpolate(plan, sc, no_body_path);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  expectValid(r.trajectory, sc);
 }
 
 TEST(Interpolator, FreeFootKeepsToAPathOfItsOwnWhileTheHandReachesTheTable) {
@@ -854,6 +901,45 @@ TEST(Interpolator, AFootHangingFromItsThighOnTheSeatSwingsDownToTheFloor) {
       EXPECT_LT((spotAt(sc, sample.q, foot).translation() - at).norm(), 1e-3);
     }
   }
+}
+
+// Interpolates a two- or three-stance plan cut from a chair_paper plan,
+// every stance kept, and checks every sample independently.
+void expectPaperChairPieceInterpolates(const std::string& file) {
+  const Scenario& sc = paperChairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/" + file), sc);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  expectValid(r.trajectory, sc);
+}
+
+TEST(Interpolator, AFreeArmOnItsPlannedPathDoesNotJumpAcrossTheTableEdge) {
+  // The left palm leaves the table; the free right arm goes from under the
+  // table's edge to the side, its joints planned around the edge. The knots
+  // used to follow that path only halfway (the cost's target halfway to the
+  // previous knot): the arm lagged, then jumped across the edge between two
+  // knots (0.12 rad), and no refinement closed the gap (the hand 0.1 mm into
+  // the top). Now a planned limb's target is its path.
+  expectPaperChairPieceInterpolates("chair_paper_arm_around_table_edge.plan.json");
+}
+
+TEST(Interpolator, AForearmLiftedOffTheTableLeavesItsPathAndSwingsTheArmAroundTheEdge) {
+  // Seated on the left thigh, the left forearm leaves the table for a
+  // witness where the arm hangs below its top. No spline for the forearm
+  // can be followed (no posture at 0.3 of it, nor with via-points or OMPL's
+  // path): the forearm turns about the elbow. Last stage: the body free in
+  // the air, its arm's joints planned around the edge from touching.
+  expectPaperChairPieceInterpolates("chair_paper_forearm_off_table.plan.json");
+}
+
+TEST(Interpolator, AFreeArmThroughANarrowGapIsPlannedNarrower) {
+  // The left thigh leaves the seat while the free left arm goes from
+  // beside the table's edge to over its top, 5 mm from the edge in both
+  // witnesses: no joint path keeps 10 mm clear, one keeps 3 mm; the knots
+  // keep the posture generator's 5 mm around it.
+  expectPaperChairPieceInterpolates("chair_paper_arm_through_gap.plan.json");
 }
 
 TEST(Interpolator, BadInputAndCancellation) {
