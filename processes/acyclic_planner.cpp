@@ -110,6 +110,8 @@ int main(int argc, char** argv) {
     if (s.plans_verified > 0)
       std::printf("acyclic-planner: transitions verified: %ld plans checked, %ld refused, %ld transitions solved, "
                   "%.2f s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds);
+    for (std::size_t i = 0; i < r.refusals.size(); ++i)
+      std::printf("acyclic-planner: plan %zu refused at %s\n", i + 1, r.refusals[i].c_str());
     if (!r.solved()) {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
       return 1;

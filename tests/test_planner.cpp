@@ -402,6 +402,12 @@ TEST(ContactPlanner, APlanWhoseTransitionTheVerifierRefusesIsDroppedAndTheSearch
   EXPECT_EQ(seen.front().stances.size(), plain.plan.stances.size());  // the plain search's plan, first
   EXPECT_EQ(r.stats.plans_verified, static_cast<long>(seen.size()));
   EXPECT_EQ(r.stats.plans_refused, static_cast<long>(seen.size()) - 1);
+  // Each refusal reported with its transition and the verifier's reason.
+  ASSERT_EQ(r.refusals.size(), seen.size() - 1);
+  for (const auto& why : r.refusals) {
+    EXPECT_EQ(why.rfind("stances ", 0), 0u) << why;
+    EXPECT_NE(why.find("refused by the test"), std::string::npos) << why;
+  }
   for (const auto& st : r.plan.stances) EXPECT_FALSE(same(st.configuration, refused));
   EXPECT_GT(r.stats.nodes_generated, plain.stats.nodes_generated);
   // The same search again: the same plan (the verifier's verdicts are a function of the plan).

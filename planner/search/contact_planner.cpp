@@ -890,6 +890,8 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
           break;
         }
         ++I.stats.plans_refused;
+        out.refusals.push_back("stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
+                               ": " + v.reason.substr(0, 300));
         const auto to = static_cast<std::size_t>(v.failed_to);
         const int owner = I.stance_owner.at(to);
         // A transition into a settled stance (between a removal and an

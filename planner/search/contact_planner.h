@@ -19,6 +19,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "planner/plan/plan.h"
 #include "planner/posture/posture_generator.h"
@@ -119,6 +120,9 @@ struct PlanningResult {
   std::string reason;
   Plan plan;            // the path to the goal (Solved), else empty
   PlanningStats stats;
+  // Each plan the verifier refused (verify_transitions), in order: its first
+  // failing transition, "stances A -> B: " and the reason's first 300 characters.
+  std::vector<std::string> refusals;
   bool solved() const { return status == Status::Solved; }
 };
 
