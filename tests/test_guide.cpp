@@ -279,9 +279,11 @@ TEST(GuideAuthor, AStepUpIsGuidedUnderTheCeilingAndPlannedOntoThePlatform) {
   const GuideResult g = authorGuide(sc, GuideOptions());
   ASSERT_TRUE(g.success()) << g.reason;
   const double standing = sc.robot->posture("half_sitting").base_position.z();  // soles at z = 0
-  for (const auto& q : g.guide.key_postures)
-    if (q.base_position.x() < 0.35 - 0.25 - 1e-6)  // no platform within a step: the floor's ceiling
+  for (const auto& q : g.guide.key_postures) {
+    if (q.base_position.x() < 0.35 - 0.25 - 1e-6) {  // no platform within a step: the floor's ceiling
       EXPECT_LE(q.base_position.z(), standing + GuideOptions().ceiling_slack + 1e-9) << q.base_position.transpose();
+    }
+  }
   sc.key_postures = g.guide.key_postures;
   PlannerParameters p = plannerParameters(sc);
   p.max_nodes = 200;  // solved in 24: a node budget, not the machine's speed, bounds a failing run
