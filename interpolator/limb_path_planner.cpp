@@ -94,6 +94,13 @@ double limbSweepClearance(const CollisionModel& collisions, Kinematics& kin, int
   return c;
 }
 
+LimbJointPath straightLimbPath(const RobotModel& robot, int root_joint, const Configuration& q0,
+                               const Configuration& q1) {
+  std::vector<int> joints = robot.jointsMovedBy(root_joint);
+  std::vector<Eigen::VectorXd> ends{limbValues(q0, joints), limbValues(q1, joints)};
+  return LimbJointPath(std::move(joints), std::move(ends), {0.0, 1.0});
+}
+
 LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int root_joint, const Configuration& q0,
                           const Configuration& q1, const LimbPathPlanOptions& o) {
   LimbPathPlan out;
@@ -114,16 +121,17 @@ LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int
     return clearanceAt(collisions, kin, pairs, q, o.clearance);
   };
   // Each end as close as its witness has it.
+  // With touching ends, an end within 1 mm but not deeper in than the
+  // contact's 0.1 mm counts as touching: clearance -0.1 mm.
+  constexpr double kTouch = -1e-4;
   double c0 = clearance(a0, 0), c1 = clearance(a1, 1);
-  if (o.touching_ends) {
-    constexpr double kTouch = -1e-4;
-    if (c0 <= 1e-3 && c0 >= kTouch) c0 = kTouch;
-    if (c1 <= 1e-3 && c1 >= kTouch) c1 = kTouch;
-  }
-  if (!o.touching_ends && !(std::min(c0, c1) > 1e-3)) {
+  for (double* c : {&c0, &c1})
+    if (o.touching_ends && *c <= 1e-3 && *c >= kTouch) *c = kTouch;
+  auto close = [&](double c) { return !(c > 1e-3) && c != kTouch; };
+  if (close(c0) || close(c1)) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "the limb's path cannot be planned: its %s witness has it within 1 mm of an obstacle or another link",
-                  c0 <= c1 ? "first" : "last");
+                  close(c0) ? "first" : "last");
     out.reason = buf;
     return out;
   }

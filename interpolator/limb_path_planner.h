@@ -76,6 +76,10 @@ struct LimbPathPlan {
 double limbSweepClearance(const CollisionModel& collisions, Kinematics& kin, int root_joint, const Configuration& q0,
                           const Configuration& q1, double cap, int samples = 16);
 
+// The joints `root_joint` moves on their straight interpolation from q0's to q1's.
+LimbJointPath straightLimbPath(const RobotModel& robot, int root_joint, const Configuration& q0,
+                               const Configuration& q1);
+
 LimbPathPlan planLimbPath(const CollisionModel& collisions, Kinematics& kin, int root_joint, const Configuration& q0,
                           const Configuration& q1, const LimbPathPlanOptions& options = {});
 

@@ -439,7 +439,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       const Configuration& q1 = plan.stances[d.to].configuration;
       const int root = sc_.robot->spotLimbRootJoint(d.spot);
       std::optional<LimbJointPath> own = plannedLimbJoints(q0, q1, root, true);
-      if (!own) own = straightLimbJoints(q0, q1, root);
+      if (!own) own = straightLimbPath(*sc_.robot, root, q0, q1);
       limbs.push_back({d.spot, BodyPath(e0, e0, 0), std::move(own)});
       at.pieces.clear();
       at.free_body = true;
@@ -511,9 +511,12 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
     r.initial_guess = guess;
     Configuration ref = lerp(q0, q1, alpha);
     for (const auto& l : limbs) ref = l.apply(ref, alpha);
-    // Planned limbs on their paths even when following the previous knot (solveMove).
-    Configuration target = follow ? lerp(guess, ref, 0.5) : ref;
-    for (const auto& l : limbs) target = l.apply(target, alpha);
+    Configuration target = ref;
+    if (follow) {
+      // Planned limbs on their paths even when following the previous knot (solveMove).
+      target = lerp(guess, ref, 0.5);
+      for (const auto& l : limbs) target = l.apply(target, alpha);
+    }
     r.cost = std::make_shared<ReferencePostureCost>(target);
     PostureResult res = generator.solve(r);
     ++at.posture_calls;
@@ -647,13 +650,6 @@ std::optional<LimbJointPath> TransitionSolver::plannedLimbJoints(const Configura
     if (planned.path) return std::move(planned.path);
   }
   return std::nullopt;
-}
-
-LimbJointPath TransitionSolver::straightLimbJoints(const Configuration& q0, const Configuration& q1, int root) const {
-  const std::vector<int> joints = sc_.robot->jointsMovedBy(root);
-  Eigen::VectorXd a(joints.size()), b(joints.size());
-  for (std::size_t k = 0; k < joints.size(); ++k) a[k] = q0.joints[joints[k]], b[k] = q1.joints[joints[k]];
-  return LimbJointPath(joints, {a, b}, {0.0, 1.0});
 }
 
 bool TransitionSolver::onFreeLimb(const TransitionDesign& d) const {

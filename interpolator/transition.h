@@ -172,8 +172,6 @@ class TransitionSolver {
   // `touching_ends`: LimbPathPlanOptions::touching_ends (the limb's own body on its surface).
   std::optional<LimbJointPath> plannedLimbJoints(const Configuration& q0, const Configuration& q1, int root,
                                                  bool touching_ends = false);
-  // The joints `root` moves on their straight interpolation from q0's to q1's.
-  LimbJointPath straightLimbJoints(const Configuration& q0, const Configuration& q1, int root) const;
   // Whether the Move's body is on a limb that holds no contact during the motion (a forearm, its arm free).
   bool onFreeLimb(const TransitionDesign& d) const;
   // A Move whose body already touches its surface in both witnesses, as the

@@ -133,6 +133,24 @@ Eigen::Isometry3d spotAt(const Scenario& sc, const Configuration& q, int spot) {
   return k.spotPose(spot);
 }
 
+// The least distance, along a limb's joint path (the rest of the body on
+// the witnesses' interpolation at its progress, `samples` points), of the
+// pairs the limb's links make with the obstacles and the robot's other links.
+double limbClearanceAlong(const Scenario& sc, const CollisionModel& collisions, Kinematics& kin, int root,
+                          const LimbJointPath& path, const Configuration& q0, const Configuration& q1, int samples) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= samples; ++i) {
+    const double s = static_cast<double>(i) / samples;
+    kin.setConfiguration(path.apply(lerp(q0, q1, s), s));
+    for (const auto& d : collisions.distances(kin))
+      if (sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_a) !=
+          (collisions.pairs()[d.pair].kind == CollisionPair::Kind::Self &&
+           sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_b)))
+        worst = std::min(worst, d.distance);
+  }
+  return worst;
+}
+
 }  // namespace
 
 // --- The moving body's path ---------------------------------------------------
@@ -323,18 +341,7 @@ TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEach
   EXPECT_EQ(path.apply(q1, 1).joints, q1.joints);
   for (std::size_t i = 1; i < path.params().size(); ++i) EXPECT_GT(path.params()[i], path.params()[i - 1]) << i;
   // Along it, the arm clears the table and the body, where the body is at that progress.
-  ValidityChecker checker(sc.robot, sc.scene);
-  double worst = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= 200; ++i) {
-    const double s = i / 200.0;
-    kin.setConfiguration(path.apply(lerp(q0, q1, s), s));
-    for (const auto& d : collisions.distances(kin))
-      if (sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_a) !=
-          (collisions.pairs()[d.pair].kind == CollisionPair::Kind::Self &&
-           sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_b)))
-        worst = std::min(worst, d.distance);
-  }
-  EXPECT_GT(worst, 0.0);
+  EXPECT_GT(limbClearanceAlong(sc, collisions, kin, root, path, q0, q1, 200), 0.0);
   // Seeded: the same path again.
   const LimbPathPlan again = planLimbPath(collisions, kin, root, q0, q1);
   ASSERT_TRUE(again.path);
@@ -372,17 +379,8 @@ TEST(LimbPathPlanner, AForearmOnTheTableIsTouchingAtItsEndOnlyWhenToldSo) {
   ASSERT_TRUE(p.path) << p.reason;
   EXPECT_GT(p.path->waypoints().size(), 2u);
   // Between its waypoints, as planned (the body at the path's own progress):
-  // never into the table by more than the contact's 0.1 mm.
-  double worst = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= 400; ++i) {
-    const double s = i / 400.0;
-    kin.setConfiguration(p.path->apply(lerp(q0, q1, s), s));
-    for (const auto& d : collisions.distances(kin))
-      if (collisions.pairs()[d.pair].kind == CollisionPair::Kind::RobotEnvironment &&
-          sc.robot->jointMovesLink(root, collisions.pairs()[d.pair].link_a))
-        worst = std::min(worst, d.distance);
-  }
-  EXPECT_GT(worst, -2e-4);
+  // never into the table, nor the body, by more than the contact's 0.1 mm.
+  EXPECT_GT(limbClearanceAlong(sc, collisions, kin, root, *p.path, q0, q1, 400), -2e-4);
 }
 
 TEST(LimbJointPath, InterpolatesBetweenWaypointsAtTheirProgress) {
