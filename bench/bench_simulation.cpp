@@ -1,6 +1,6 @@
 // The dynamics simulation's speed: simulated seconds per wall second (median
-// over --runs runs) executing step_forward's trajectory (planned and
-// interpolated here first) and any trajectory files given, with the verdict,
+// over --runs runs) executing step_forward's and sit_down's trajectories
+// (planned and interpolated here first, with the scenarios' margins) and any trajectory files given, with the verdict,
 // the integrator's steps and mean step.
 // Usage: bench_simulation [--trajectory T]... [--runs N]; --help lists the options.
 #include <algorithm>
@@ -39,25 +39,27 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   int runs = 3;
   CLI::App app{"The dynamics simulation's speed: simulated seconds per wall second (median over the runs) on\n"
-               "step_forward's trajectory (planned and interpolated first) and on each trajectory file given."};
+               "step_forward's and sit_down's trajectories (planned and interpolated first) and on each trajectory file given."};
   app.add_option("--trajectory", files, "also this trajectory file (its scenario from its 'scenario' field); repeatable");
   app.add_option("--runs", runs, "runs per trajectory (default 3)")->check(acyclic::bench::positive());
   CLI11_PARSE(app, argc, argv);
 
   std::printf("%-22s %8s %8s %8s %9s %9s %9s  %s\n", "trajectory", "sim s", "wall s", "sim/wall", "min", "steps",
               "mean ms", "verdict");
-  const Scenario sc = Scenario::load(ACYCLIC_SOURCE_DIR "/models/scenarios/step_forward.yaml");
-  const PlanningResult p = ContactPlanner(sc, plannerParameters(sc)).plan();
-  if (!p.solved()) {
-    std::printf("bench_simulation: step_forward not planned: %s\n", p.reason.c_str());
-    return 1;
+  for (const char* name : {"step_forward", "sit_down"}) {
+    const Scenario sc = Scenario::load(std::string(ACYCLIC_SOURCE_DIR "/models/scenarios/") + name + ".yaml");
+    const PlanningResult p = ContactPlanner(sc, plannerParameters(sc)).plan();
+    if (!p.solved()) {
+      std::printf("bench_simulation: %s not planned: %s\n", name, p.reason.c_str());
+      return 1;
+    }
+    const InterpolationResult t = interpolate(p.plan, sc, withScenarioMargins(sc, {}));
+    if (!t.success()) {
+      std::printf("bench_simulation: %s not interpolated: %s\n", name, t.reason.c_str());
+      return 1;
+    }
+    run(name, sc, t.trajectory, runs);
   }
-  const InterpolationResult t = interpolate(p.plan, sc, {});
-  if (!t.success()) {
-    std::printf("bench_simulation: step_forward not interpolated: %s\n", t.reason.c_str());
-    return 1;
-  }
-  run("step_forward", sc, t.trajectory, runs);
   for (const auto& f : files) {
     const hrp2::LoadedTrajectory l = hrp2::loadTrajectoryFile(f);
     run(l.scenario.name, l.scenario, l.trajectory, runs);

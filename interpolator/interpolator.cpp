@@ -63,6 +63,15 @@ std::string validateOptions(const InterpolatorOptions& o) {
 
 }  // namespace
 
+InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions o) {
+  if (!sc.planner_section) return o;
+  const YamlField& f = *sc.planner_section;
+  if (f.has("posture_support_inset")) o.support_inset = f["posture_support_inset"].number();
+  if (f.has("posture_support_inset_y")) o.support_inset_y = f["posture_support_inset_y"].number();
+  if (f.has("posture_friction_share")) o.friction_share = f["posture_friction_share"].number();
+  return o;
+}
+
 TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
   TransitionOptions to;
   to.steps = opt.steps;

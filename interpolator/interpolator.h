@@ -77,6 +77,13 @@ struct InterpolationResult {
 
 const char* toString(InterpolationResult::Status s);
 
+// `options` with the scenario's stability margins (its planner section's
+// posture_support_inset, posture_support_inset_y and posture_friction_share)
+// where it sets them: the knots between two stances keep the margins the
+// stances were planned with. The interpolator's command line and the plan
+// verifier start from these; a margin given on the command line wins.
+InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions options);
+
 // The transition solver's options the interpolator uses for these options
 // (the plan verifier, plan_verifier.h, solves with the same).
 TransitionOptions transitionOptions(const InterpolatorOptions& options);

@@ -56,16 +56,15 @@ int main(int argc, char** argv) {
   app.add_option("--pyramid-edges", o.pyramid_edges,
                  "edges of the knots' friction pyramid: 4 (every other edge of the contract's) or 8 (all)")
       ->capture_default_str();
-  app.add_option("--support-inset", o.support_inset,
+  auto* inset_flag = app.add_option("--support-inset", o.support_inset,
                  "stability margin of the knots: each supporting contact's forces applied this far (m) inside "
-                 "its spot's edges")
-      ->capture_default_str();
-  app.add_option("--support-inset-y", o.support_inset_y,
-                 "the same along each spot's y axis (across a sole) instead, m (negative: --support-inset)")
-      ->capture_default_str();
-  app.add_option("--friction-share", o.friction_share,
-                 "stability margin of the knots: the share of each surface's friction coefficient used, in (0, 1]")
-      ->capture_default_str();
+                 "its spot's edges (default: the scenario's planner key posture_support_inset, else 0)");
+  auto* inset_y_flag = app.add_option("--support-inset-y", o.support_inset_y,
+                 "the same along each spot's y axis (across a sole) instead, m (negative: --support-inset; default: "
+                 "the scenario's posture_support_inset_y, else -1)");
+  auto* share_flag = app.add_option("--friction-share", o.friction_share,
+                 "stability margin of the knots: the share of each surface's friction coefficient used, in (0, 1] "
+                 "(default: the scenario's planner key posture_friction_share, else 1)");
   app.add_option("--link-acceleration-cap", o.link_acceleration_cap,
                  "largest acceleration of any link origin, m/s^2 (joints: the robot file's acceleration_limits)")
       ->capture_default_str();
@@ -78,6 +77,16 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.filter = !no_filter;
+  // The scenario's margins unless the command line gives them.
+  const bool inset_given = inset_flag->count() > 0, inset_y_given = inset_y_flag->count() > 0,
+             share_given = share_flag->count() > 0;
+  const acyclic::InterpolatorOptionsFor options_for = [=](const acyclic::Scenario& sc) {
+    acyclic::InterpolatorOptions r = acyclic::withScenarioMargins(sc, o);
+    if (inset_given) r.support_inset = o.support_inset;
+    if (inset_y_given) r.support_inset_y = o.support_inset_y;
+    if (share_given) r.friction_share = o.friction_share;
+    return r;
+  };
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   if (lcm_mode) {
     if (!in.empty() || !out.empty()) {
@@ -85,7 +94,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     acyclic::proc::installSignalHandlers();
-    return acyclic::serveInterpolator(url, o);
+    return acyclic::serveInterpolator(url, options_for);
   }
   if (in.empty() || out.empty()) {
     std::fprintf(stderr, "acyclic-interpolator: give --in PLAN --out TRAJECTORY (file mode) or --lcm; see --help\n");
@@ -104,7 +113,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "\r%7.1f s  %-11s transition %d of %d  posture calls %ld   ", p.seconds, p.stage.c_str(),
                    p.transition, p.transitions, p.posture_calls);
     };
-    acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, o, progress, &g_stop);
+    acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, options_for(sc), progress, &g_stop);
     if (tty) std::fprintf(stderr, "\n");
     if (!r.success()) {
       std::printf("acyclic-interpolator: %s: %s: %s\n", in.c_str(), acyclic::toString(r.status), r.reason.c_str());

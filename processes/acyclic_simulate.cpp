@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <unistd.h>
 
 #include "hrp2_bridge/sim/dynamics_simulation.h"
@@ -23,6 +24,8 @@ int main(int argc, char** argv) {
       "spots' polygon corners against the scene's surfaces with their friction. Prints per phase the base\n"
       "drift and tilt against the plan, each contact's slip, lift-off and force against the quasi-static\n"
       "plan's, the worst joint tracking error, and the verdict (executed / fell / slipped, time, reason).\n"
+      "Where HRP-2's bridge runs its stabilizer (only coplanar feet touch), a model of it corrects the legs'\n"
+      "references from the measured foot forces and centre of mass (--no-stabilizer: open-loop throughout).\n"
       "Progress on stderr when it is a terminal.\n"
       "Exit status: 0 executed, 1 fell or slipped, 2 bad input."};
   std::string scenario_path, trajectory_path, report_path;
@@ -35,14 +38,28 @@ int main(int argc, char** argv) {
   app.add_option("--base-bound", o.base_bound, "acceptance: base within this of the plan, m (default 0.02)");
   app.add_option("--settle", o.settle, "hold the last reference this long after the end, s (default 0.5)");
   app.add_option("--accuracy", o.accuracy, "integrator accuracy, relative local error (default 1e-3)");
-  app.add_option("--integrator", o.integrator, "semi-explicit-euler2 (default), rk-merson or rk3");
+  app.add_option("--integrator", o.integrator, "cpodes (default; implicit BDF), semi-explicit-euler2, rk-merson or rk3");
   app.add_option("--full-torque-error", o.full_torque_error,
                  "servo stiffness: a joint's whole effort limit at this error, rad (default 0.01)");
   app.add_option("--transition-velocity", o.transition_velocity,
-                 "friction's stiction regularization velocity, m/s (default 0.01)");
+                 "friction's stiction regularization velocity, m/s (default 0.001)");
+  std::string trace_path;
+  app.add_option("--trace", trace_path,
+                 "write one CSV row per controller period: time, phase, stabilizer flag, centre of mass and base "
+                 "(simulated and planned, world, m), tilt (rad), each spot's vertical force (world z, N)");
+  bool open_loop = false;
+  app.add_flag("--no-stabilizer", open_loop,
+               "play every phase open-loop: no model of HRP-2's stabilizer, even where the bridge runs it (only coplanar feet touch)");
+  app.add_option("--stabilizer-cop-gain", o.stabilizer_options.cop_gain,
+                 "stabilizer: a foot's turn rate per metre of centre-of-pressure error, rad/s/m (default 5)");
+  app.add_option("--stabilizer-force-damping", o.stabilizer_options.force_damping,
+                 "stabilizer: a foot rises at (measured - wanted normal force) / this, N s/m (default 2e4)");
+  app.add_option("--stabilizer-off-time", o.stabilizer_options.off_time,
+                 "stabilizer: switched off, its offsets fade out with this time constant, s (default 0.3)");
   app.add_flag("-q,--quiet", quiet, "print only the verdict");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
+  o.stabilizer = !open_loop;
   hrp2::LoadedTrajectory loaded;
   try {
     o.validate();
@@ -64,7 +81,28 @@ int main(int argc, char** argv) {
     };
   hrp2::SimulationReport r;
   try {
-    r = hrp2::simulate(sc, tr, o, progress);
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace_file(nullptr, &std::fclose);
+    hrp2::SimulationTrace trace;
+    if (!trace_path.empty()) {
+      trace_file.reset(std::fopen(trace_path.c_str(), "w"));
+      if (!trace_file) {
+        std::fprintf(stderr, "acyclic-simulate: cannot write the trace %s\n", trace_path.c_str());
+        return 2;
+      }
+      std::fprintf(trace_file.get(), "t,phase,stabilizer,com_x,com_y,com_z,plan_com_x,plan_com_y,plan_com_z,"
+                                     "base_x,base_y,base_z,plan_base_x,plan_base_y,plan_base_z,tilt");
+      for (const auto& s : sc.robot->spots()) std::fprintf(trace_file.get(), ",%s_fz", s.name.c_str());
+      std::fprintf(trace_file.get(), "\n");
+      trace = [f = trace_file.get()](const hrp2::SimulationSample& s) {
+        std::fprintf(f, "%.3f,%d,%d", s.t, s.phase, s.stabilizer_on ? 1 : 0);
+        for (const Eigen::Vector3d* v : {&s.com, &s.plan_com, &s.base, &s.plan_base})
+          std::fprintf(f, ",%.5f,%.5f,%.5f", v->x(), v->y(), v->z());
+        std::fprintf(f, ",%.5f", s.tilt);
+        for (const auto& fs : s.spot_forces) std::fprintf(f, ",%.1f", fs.z());
+        std::fprintf(f, "\n");
+      };
+    }
+    r = hrp2::simulate(sc, tr, o, progress, trace);
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");
     std::fprintf(stderr, "acyclic-simulate: the simulation failed: %s\n", e.what());
@@ -94,6 +132,11 @@ int main(int argc, char** argv) {
                 r.worst_tracking_joint.c_str());
     std::printf("integrator: %s, accuracy %g, %ld steps (mean %.3g ms)\n", o.integrator.c_str(), o.accuracy,
                 r.integrator_steps, 1e3 * r.mean_step);
+    if (o.stabilizer)
+      std::printf("stabilizer: on %.2f s of %.2f, a foot's turn up to %.2f deg, its rise up to %.1f mm\n",
+                  r.stabilizer_on_time, tr.duration(), r.stabilizer_max_tilt * 180 / M_PI, 1e3 * r.stabilizer_max_lift);
+    else
+      std::printf("stabilizer: none (--no-stabilizer), every phase open-loop\n");
     std::printf("time: %.2f s simulated in %.2f s wall (%.2fx real time)\n", r.motion_time, r.wall_time,
                 r.wall_time > 0 ? r.motion_time / r.wall_time : 0.0);
     std::printf("acceptance: %s (no fall, supporting slip < %.0f mm, base within %.0f mm of the plan)\n",

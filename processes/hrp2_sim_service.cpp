@@ -40,7 +40,14 @@ int serveSimulator(const SimServiceOptions& options) {
       std::vector<std::pair<int, int>> pairs;  // every allowed spot may touch every allowed surface
       for (int spot : sc.allowed_spots)
         for (int surface : sc.allowed_surfaces) pairs.push_back({spot, surface});
-      dyn = std::make_unique<hrp2::DynamicsSimulator>(sc, start, hrp2::DynamicsOptions{}, pairs);
+      // Real time first: the explicit integrator and Simbody's default
+      // stiction regularization. acyclic-simulate's cpodes at 0.001 m/s is
+      // closer to Coulomb friction, but streamed at 5 ms it fell behind the
+      // clock here (the bridge saw HRP2_STATE 88 ms stale).
+      hrp2::DynamicsOptions d;
+      d.integrator = "semi-explicit-euler2";
+      d.transition_velocity = 0.01;
+      dyn = std::make_unique<hrp2::DynamicsSimulator>(sc, start, d, pairs);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: %s\n", kName, e.what());

@@ -29,7 +29,7 @@ int8_t trajectoryStatus(InterpolationResult::Status s) {
 
 class InterpolatorService : public proc::Service {
  public:
-  InterpolatorService(proc::Bus& bus, InterpolatorOptions o) : proc::Service(bus, kProcess), options_(o) {
+  InterpolatorService(proc::Bus& bus, InterpolatorOptionsFor o) : proc::Service(bus, kProcess), options_(std::move(o)) {
     bus.lcm().subscribe(channels::kPlan, &InterpolatorService::onPlan, this);
     bus.lcm().subscribe(channels::kCancel, &InterpolatorService::onCancel, this);
     status_.ready();
@@ -89,7 +89,7 @@ class InterpolatorService : public proc::Service {
           msg.message = "transition " + std::to_string(p.transition) + " of " + std::to_string(p.transitions);
           bus_.publish(channels::kProgress, msg);
         };
-        const InterpolationResult r = interpolate(*plan, *sc, options_, progress, &cancel);
+        const InterpolationResult r = interpolate(*plan, *sc, options_(*sc), progress, &cancel);
         if (r.success()) out = convert::toMessage(r.trajectory, *sc);
         out.status = trajectoryStatus(r.status);
         out.reason = r.reason;
@@ -119,12 +119,12 @@ class InterpolatorService : public proc::Service {
       proc::log(kProcess, "request " + std::to_string(worker_.current()) + ": cancelled (" + c.reason + ")");
   }
 
-  InterpolatorOptions options_;
+  InterpolatorOptionsFor options_;
 };
 
 }  // namespace
 
-int serveInterpolator(const std::string& lcm_url, const InterpolatorOptions& options) {
+int serveInterpolator(const std::string& lcm_url, const InterpolatorOptionsFor& options) {
   return proc::serve<InterpolatorService>(lcm_url, kProcess, channels::kPlan, options);
 }
 

@@ -1051,6 +1051,46 @@ TEST(InterpolatorProcess, WritesATrajectoryThatAcyclicCheckAccepts) {
   EXPECT_NE(bad.output.find("spot origin"), std::string::npos) << bad.output;
 }
 
+// The knots keep the stability margins the scenario's stances were planned
+// with (its planner section), unless the command line says otherwise: the
+// scenario's 6 cm inset gives the trajectory that --support-inset 0.06
+// gives, and moves the single supports' centre of mass away from where no
+// margin leaves it; --support-inset 0 on the command line wins.
+TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem) {
+  const Scenario& sc = floorScenario();
+  test::TempDir dir;
+  const std::string scenario =
+      dir.write("margins.yaml", test::scenarioText("models/scenarios/step_forward.yaml") +
+                                    "planner: {posture_support_inset: 0.06, posture_friction_share: 0.5}\n");
+  const Scenario with = Scenario::load(scenario);
+  const InterpolatorOptions o = withScenarioMargins(with, {});
+  EXPECT_DOUBLE_EQ(o.support_inset, 0.06);
+  EXPECT_DOUBLE_EQ(o.friction_share, 0.5);
+  EXPECT_DOUBLE_EQ(o.support_inset_y, -1.0);
+  EXPECT_DOUBLE_EQ(withScenarioMargins(sc, {}).support_inset, 0.0);
+  const std::string plan = dir.path() + "/step.json";
+  writePlan(stepPlan(sc, 0.15), sc, plan);
+  auto run = [&](const std::string& out, const std::string& flags) {
+    const auto r = test::runProcess(test::binaryPath("processes/acyclic-interpolator") + " -q -n 10 --scenario " +
+                                    scenario + " --in " + plan + " --out " + dir.path() + "/" + out + " " + flags);
+    EXPECT_EQ(r.status, 0) << r.output;
+    return readTrajectory(dir.path() + "/" + out, with);
+  };
+  const Trajectory by_scenario = run("a.json", ""), given = run("b.json", "--support-inset 0.06 --friction-share 0.5"),
+                   none = run("c.json", "--support-inset 0 --friction-share 1");
+  ASSERT_EQ(by_scenario.samples.size(), given.samples.size());
+  for (std::size_t k = 0; k < given.samples.size(); ++k)
+    ASSERT_EQ(by_scenario.samples[k].q.joints, given.samples[k].q.joints) << "sample " << k;
+  double apart = 0;
+  Kinematics a(sc.robot), b(sc.robot);
+  for (std::size_t k = 0; k < std::min(none.samples.size(), given.samples.size()); ++k) {
+    a.setConfiguration(given.samples[k].q);
+    b.setConfiguration(none.samples[k].q);
+    apart = std::max(apart, (a.centerOfMass() - b.centerOfMass()).head<2>().norm());
+  }
+  EXPECT_GT(apart, 0.005);
+}
+
 TEST(InterpolatorProcess, HelpAndBadInput) {
   const std::string interp = test::binaryPath("processes/acyclic-interpolator");
   const auto help = test::runProcess(interp + " --help");

@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "hrp2_bridge/bridge_config.h"
+#include "hrp2_bridge/stabilizer_schedule.h"
 #include "planner/check/quasi_static.h"
 #include "planner/model/kinematics.h"
 
@@ -111,9 +113,10 @@ void DynamicsOptions::validate() const {
   positive(fall_tilt, "fall_tilt");
   positive(base_bound, "base_bound");
   if (!(dissipation >= 0)) throw std::invalid_argument("dissipation must be >= 0");
-  if (integrator != "rk-merson" && integrator != "rk3" && integrator != "semi-explicit-euler2")
+  if (integrator != "rk-merson" && integrator != "rk3" && integrator != "semi-explicit-euler2" && integrator != "cpodes")
     throw std::invalid_argument("integrator must be rk-merson, rk3 or semi-explicit-euler2 (got " + integrator + ")");
   if (!(settle >= 0)) throw std::invalid_argument("settle must be >= 0");
+  stabilizer_options.validate();
 }
 
 const char* toString(SimulationReport::Verdict v) {
@@ -297,6 +300,7 @@ struct DynamicsSimulator::Impl {
     // reference segment is integrated with the reference it was set for.
     if (opt.integrator == "rk-merson") integ = std::make_unique<SimTK::RungeKuttaMersonIntegrator>(system);
     else if (opt.integrator == "rk3") integ = std::make_unique<SimTK::RungeKutta3Integrator>(system);
+    else if (opt.integrator == "cpodes") integ = std::make_unique<SimTK::CPodesIntegrator>(system, SimTK::CPodes::BDF);
     else integ = std::make_unique<SimTK::SemiExplicitEuler2Integrator>(system);
     integ->setAccuracy(opt.accuracy);
     integ->setMaximumStepSize(opt.max_step);
@@ -335,21 +339,37 @@ struct DynamicsSimulator::Impl {
     return toEigen(matter.getMobilizedBody(link_mobod[s.link]).getBodyTransform(current())) * s.frame;
   }
 
-  std::vector<Eigen::Vector3d> spotForces() const {
+  // Per spot: the contact force and its moment about the spot's origin (world).
+  std::vector<SpotWrench> spotWrenches() const {
     const SimTK::State& st = current();
     system.realize(st, SimTK::Stage::Dynamics);
-    std::vector<Eigen::Vector3d> out(robot->spots().size(), Eigen::Vector3d::Zero());
+    std::vector<SpotWrench> out(robot->spots().size());
+    std::vector<Eigen::Vector3d> origin(robot->spots().size());
+    for (std::size_t s = 0; s < origin.size(); ++s) origin[s] = spotPose(static_cast<int>(s)).translation();
     const SimTK::ContactSnapshot& snap = tracker.getActiveContacts(st);
     for (int i = 0; i < contact.getNumContactForces(st); ++i) {
       const SimTK::ContactForce& f = contact.getContactForce(st, i);
       if (!snap.hasContact(f.getContactId())) continue;
       const SimTK::Contact& c = snap.getContactById(f.getContactId());
-      const Eigen::Vector3d on2 = toEigen(f.getForceOnSurface2()[1]);
+      const Eigen::Vector3d on2 = toEigen(f.getForceOnSurface2()[1]), m2 = toEigen(f.getForceOnSurface2()[0]);
+      const Eigen::Vector3d at = toEigen(f.getContactPoint());
+      double sign = 1;
       auto it = sphere_of_surface.find(static_cast<int>(c.getSurface2()));
-      if (it != sphere_of_surface.end()) out[it->second.spot] += on2;
-      else if ((it = sphere_of_surface.find(static_cast<int>(c.getSurface1()))) != sphere_of_surface.end())
-        out[it->second.spot] -= on2;
+      if (it == sphere_of_surface.end()) {
+        it = sphere_of_surface.find(static_cast<int>(c.getSurface1()));
+        sign = -1;
+      }
+      if (it == sphere_of_surface.end()) continue;
+      SpotWrench& w = out[it->second.spot];
+      w.force += sign * on2;
+      w.moment += sign * (m2 + (at - origin[it->second.spot]).cross(on2));
     }
+    return out;
+  }
+
+  std::vector<Eigen::Vector3d> spotForces() const {
+    std::vector<Eigen::Vector3d> out;
+    for (const SpotWrench& w : spotWrenches()) out.push_back(w.force);
     return out;
   }
 
@@ -390,12 +410,13 @@ Eigen::Vector3d DynamicsSimulator::centerOfMass() const {
   return toEigen(impl_->matter.calcSystemMassCenterLocationInGround(st));
 }
 std::vector<Eigen::Vector3d> DynamicsSimulator::spotForces() const { return impl_->spotForces(); }
+std::vector<SpotWrench> DynamicsSimulator::spotWrenches() const { return impl_->spotWrenches(); }
 long DynamicsSimulator::steps() const { return impl_->integ->getNumStepsTaken(); }
 
 // ---------------------------------------------------------------------------
 
 SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const DynamicsOptions& options,
-                          const SimulationProgress& progress) {
+                          const SimulationProgress& progress, const SimulationTrace& trace) {
   if (tr.samples.empty() || tr.phases.empty()) throw std::invalid_argument("the trajectory has no samples or no phases");
   const auto wall0 = std::chrono::steady_clock::now();
   const RobotModel& m = *sc.robot;
@@ -450,6 +471,16 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
       if (first[p] >= 0) middle[p] = (first[p] + last[p]) / 2;
   }
 
+  // HRP-2's stabilizer where the bridge runs it; its offsets are added to
+  // the references (from the state measured at each period's start).
+  std::unique_ptr<FeetStabilizer> stabilizer;
+  std::vector<bool> stabilizer_on;
+  if (options.stabilizer) {
+    stabilizer = std::make_unique<FeetStabilizer>(sc.robot, sc.scene, options.stabilizer_options);
+    stabilizer_on = scheduleStabilizer(tr, m, *sc.scene, BridgeConfig{}).sample_on;
+  }
+  Eigen::VectorXd offset_from = Eigen::VectorXd::Zero(m.numJoints()), offset_to = offset_from;
+
   bool fell = false;
   double last_progress = -1;
   for (int k = 1; k < N + settle_steps && !fell; ++k) {
@@ -457,7 +488,18 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
     const TrajectorySample& to = tr.samples[std::min(k, N - 1)];
     const double t0 = (k - 1) * dt, t1 = k * dt;
     const Eigen::VectorXd rest = Eigen::VectorXd::Zero(to.dq.size());
-    S.ref = {t0, t1, from.q.joints, k - 1 < N ? from.dq : rest, to.q.joints, k < N ? to.dq : rest};
+    if (stabilizer) {
+      const bool on = stabilizer_on[std::min(k, N - 1)];
+      offset_from = offset_to;
+      offset_to = stabilizer->update(dt, on, to.q, tr.phases[to.phase].contacts, sim.centerOfMass(), S.spotWrenches());
+      if (on && k < N) rep.stabilizer_on_time += dt;
+      for (int s = 0; s < static_cast<int>(m.spots().size()); ++s) {
+        rep.stabilizer_max_tilt = std::max(rep.stabilizer_max_tilt, stabilizer->tilt(s).norm());
+        rep.stabilizer_max_lift = std::max(rep.stabilizer_max_lift, std::abs(stabilizer->lift(s)));
+      }
+    }
+    S.ref = {t0, t1, from.q.joints + offset_from, k - 1 < N ? from.dq : rest, to.q.joints + offset_to,
+             k < N ? to.dq : rest};
     if (phase < 0) startPhase(tr.samples[0].phase, 0.0);
     S.advanceTo(t1);
     if (k < N && to.phase != phase) {
@@ -508,6 +550,20 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
                       co.left_surface ? "left the surface" : "slipped beyond the bound", phase, 1e3 * co.slip);
         slip_reason = buf;
       }
+    }
+    if (trace) {
+      SimulationSample ts;
+      ts.t = t1;
+      ts.phase = phase;
+      ts.stabilizer_on = stabilizer && stabilizer_on[std::min(k, N - 1)];
+      ts.com = sim.centerOfMass();
+      kin.setConfiguration(to.q);
+      ts.plan_com = kin.centerOfMass();
+      ts.base = q.base_position;
+      ts.plan_base = to.q.base_position;
+      ts.tilt = tilt;
+      ts.spot_forces = f;
+      trace(ts);
     }
     // A fall: the base far below the plan or tilted far from it.
     if (to.q.base_position.z() - q.base_position.z() > options.fall_height || tilt > options.fall_tilt) {
@@ -571,6 +627,17 @@ std::string reportToJson(const SimulationReport& r) {
   j["worst_tracking_joint"] = r.worst_tracking_joint;
   j["integrator"] = {{"name", r.options.integrator}, {"accuracy", r.options.accuracy}, {"max_step", r.options.max_step},
                      {"steps", r.integrator_steps}, {"mean_step", r.mean_step}};
+  j["stabilizer"] = {{"on", r.options.stabilizer}, {"on_time", r.stabilizer_on_time},
+                     {"max_tilt", r.stabilizer_max_tilt}, {"max_lift", r.stabilizer_max_lift},
+                     {"zmp_com_gain", r.options.stabilizer_options.zmp_com_gain},
+                     {"zmp_velocity_gain", r.options.stabilizer_options.zmp_velocity_gain},
+                     {"cop_gain", r.options.stabilizer_options.cop_gain},
+                     {"cop_leak", r.options.stabilizer_options.cop_leak},
+                     {"max_tilt_bound", r.options.stabilizer_options.max_tilt},
+                     {"force_damping", r.options.stabilizer_options.force_damping},
+                     {"force_leak", r.options.stabilizer_options.force_leak},
+                     {"max_lift_bound", r.options.stabilizer_options.max_lift},
+                     {"off_time", r.options.stabilizer_options.off_time}};
   j["options"] = {{"full_torque_error", r.options.full_torque_error}, {"damping_ratio", r.options.damping_ratio},
                   {"sphere_radius", r.options.sphere_radius}, {"stiffness", r.options.stiffness},
                   {"dissipation", r.options.dissipation}, {"transition_velocity", r.options.transition_velocity},

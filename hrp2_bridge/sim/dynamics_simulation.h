@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include "hrp2_bridge/sim/feet_stabilizer.h"
 #include "planner/plan/trajectory.h"
 #include "planner/scene/scenario.h"
 
@@ -35,18 +36,28 @@ struct DynamicsOptions {
   double dissipation = 2.0;          // s/m, Hunt-Crossley c
   // Simbody's friction is regularized: below this slip speed it is viscous,
   // so a contact under a tangential load t creeps at about
-  // transition_velocity * t / (mu N). Simbody's default; 0.05 runs 3x faster
-  // but lets a foot creep centimetres over a few seconds of standing.
-  double transition_velocity = 0.01; // m/s
+  // transition_velocity * t / (mu N). Coulomb friction does not creep: the
+  // smaller, the closer (and the stiffer the equations). Simbody's default,
+  // 0.01, lets the internal squeeze between a foot and a thigh on a seat
+  // (100 N, from the servos' sag when the thigh lands) creep 17-20 mm over
+  // sit_down's 8 s seated phase; 0.001 leaves 4 mm.
+  double transition_velocity = 0.001; // m/s
   // Integration: a Simbody variable-step integrator with error control
-  // ("semi-explicit-euler2", "rk-merson" or "rk3"), this accuracy (relative
-  // local error), steps at most max_step. SemiExplicitEuler2 (velocities
-  // first, then positions with them; two evaluations a step) is made for
-  // stiff contact: on step_forward it takes the same verdicts and figures as
-  // Runge-Kutta-Merson in half its wall time.
-  std::string integrator = "semi-explicit-euler2";
+  // ("cpodes", "semi-explicit-euler2", "rk-merson" or "rk3"), this accuracy
+  // (relative local error), steps at most max_step. CPodes' BDF (implicit,
+  // Newton iterations) is made for stiff equations, and the stiction above
+  // is stiff: on sit_down's 86.7 s trajectory it takes 2.3 ms steps and runs
+  // 5.9x faster than real time where SemiExplicitEuler2 (explicit, made for
+  // stiff contact) needs 0.09 ms steps at 0.002 m/s and runs at 0.6x; both
+  // give the same verdict and figures within 0.2 mm.
+  std::string integrator = "cpodes";
   double accuracy = 1e-3;
   double max_step = 0.005;           // s
+  // HRP-2's stabilizer (feet_stabilizer.h) where the bridge's schedule runs
+  // it (only coplanar feet touch; hrp2_bridge/stabilizer_schedule.h); the
+  // references are played open-loop elsewhere, and everywhere when false.
+  bool stabilizer = true;
+  FeetStabilizerOptions stabilizer_options;
   // After the last sample the final reference is held this long.
   double settle = 0.5;               // s
   // Verdict thresholds.
@@ -96,6 +107,9 @@ struct SimulationReport {
   bool base_within_bound = true;     // worst_base_drift <= options.base_bound
   long integrator_steps = 0;
   double mean_step = 0;              // s
+  double stabilizer_on_time = 0;     // s of the trajectory with the stabilizer on
+  double stabilizer_max_tilt = 0;    // rad, a foot's largest turn
+  double stabilizer_max_lift = 0;    // m, a foot's largest rise (or fall)
   DynamicsOptions options;
   bool executed() const { return verdict == Verdict::Executed; }
 };
@@ -107,10 +121,22 @@ void writeReport(const SimulationReport& r, const std::string& path);
 // Progress: simulated time and the total to simulate.
 using SimulationProgress = std::function<void(double t, double total)>;
 
+// One controller period as simulated, for a trace (acyclic-simulate --trace).
+struct SimulationSample {
+  double t = 0;                      // s
+  int phase = 0;
+  bool stabilizer_on = false;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero(), plan_com = Eigen::Vector3d::Zero();   // world
+  Eigen::Vector3d base = Eigen::Vector3d::Zero(), plan_base = Eigen::Vector3d::Zero(); // world
+  double tilt = 0;                   // rad, base orientation against the plan
+  std::vector<Eigen::Vector3d> spot_forces;   // world, per robot spot
+};
+using SimulationTrace = std::function<void(const SimulationSample&)>;
+
 // Plays the trajectory at its controller rate (dt) from its first sample at
 // rest, then holds the last reference for options.settle; stops early at a fall.
 SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const DynamicsOptions& options = {},
-                          const SimulationProgress& progress = {});
+                          const SimulationProgress& progress = {}, const SimulationTrace& trace = {});
 
 // The same simulator driven by a stream of references (the simulated
 // controller's dynamic mode). Contacts: every spot against the floor (the
@@ -138,6 +164,8 @@ class DynamicsSimulator {
   Eigen::Vector3d centerOfMass() const;   // world
   // Sum of the contact forces on each spot (world), zero for spots not touching.
   std::vector<Eigen::Vector3d> spotForces() const;
+  // The same with their moment about each spot's origin (world).
+  std::vector<SpotWrench> spotWrenches() const;
   long steps() const;
 
   struct Impl;

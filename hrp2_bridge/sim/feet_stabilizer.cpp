@@ -1,0 +1,189 @@
+#include "hrp2_bridge/sim/feet_stabilizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "hrp2_bridge/stabilizer_schedule.h"
+
+namespace acyclic::hrp2 {
+
+void FeetStabilizerOptions::validate() const {
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v))
+      throw std::invalid_argument(std::string("stabilizer ") + name + " must be positive (got " + std::to_string(v) + ")");
+  };
+  auto nonNegative = [](double v, const char* name) {
+    if (!(v >= 0) || !std::isfinite(v))
+      throw std::invalid_argument(std::string("stabilizer ") + name + " must be >= 0 (got " + std::to_string(v) + ")");
+  };
+  nonNegative(zmp_com_gain, "zmp_com_gain");
+  nonNegative(zmp_velocity_gain, "zmp_velocity_gain");
+  nonNegative(cop_gain, "cop_gain");
+  positive(cop_leak, "cop_leak");
+  nonNegative(max_tilt, "max_tilt");
+  positive(force_damping, "force_damping");
+  positive(force_leak, "force_leak");
+  nonNegative(max_lift, "max_lift");
+  nonNegative(cop_edge, "cop_edge");
+  positive(off_time, "off_time");
+}
+
+FeetStabilizer::FeetStabilizer(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
+                               const FeetStabilizerOptions& options)
+    : robot_(std::move(robot)), scene_(std::move(scene)), opt_(options), kin_(robot_) {
+  opt_.validate();
+  const RobotModel& m = *robot_;
+  lift_.assign(m.spots().size(), 0.0);
+  tilt_.assign(m.spots().size(), Eigen::Vector2d::Zero());
+  for (int s = 0; s < static_cast<int>(m.spots().size()); ++s) {
+    if (!isFootSpot(m, s)) continue;
+    std::vector<int> chain;
+    for (int link = m.spots()[s].link; m.links()[link].parent_joint >= 0;) {
+      const JointInfo& j = m.joints()[m.links()[link].parent_joint];
+      chain.push_back(j.index);
+      link = j.parent_link;
+    }
+    std::reverse(chain.begin(), chain.end());
+    feet_.push_back(s);
+    leg_.push_back(chain);
+  }
+}
+
+namespace {
+
+// x + dt * rate, clamped to [-bound, bound].
+double step(double x, double rate, double dt, double bound) { return std::clamp(x + dt * rate, -bound, bound); }
+
+// The point of a convex polygon nearest to p (p itself when inside).
+Eigen::Vector2d nearestIn(const ConvexPolygon& poly, const Eigen::Vector2d& p) {
+  if (poly.contains(p)) return p;
+  const auto& v = poly.vertices();
+  Eigen::Vector2d best = v.front();
+  double best_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
+    const double len2 = (b - a).squaredNorm();
+    const double s = len2 > 0 ? std::clamp((p - a).dot(b - a) / len2, 0.0, 1.0) : 0.0;
+    const Eigen::Vector2d q = a + s * (b - a);
+    if ((q - p).norm() < best_d) best_d = (q - p).norm(), best = q;
+  }
+  return best;
+}
+
+}  // namespace
+
+Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& plan,
+                                       const std::vector<ContactSpec>& contacts, const Eigen::Vector3d& com,
+                                       const std::vector<SpotWrench>& wrenches) {
+  const RobotModel& m = *robot_;
+  kin_.setConfiguration(plan);
+  const Eigen::Vector3d plan_com = kin_.centerOfMass();
+  // Velocities by differences, the measured one smoothed over 20 ms (the
+  // simulated state is exact, but a real estimate is not, and the contact
+  // springs ring).
+  if (has_last_) {
+    const double a = std::min(1.0, dt / 0.02);
+    const Eigen::Vector3d v = (com - last_com_) / dt - (plan_com - last_plan_com_) / dt;
+    com_velocity_ = (1 - a) * com_velocity_ + a * v;
+  }
+  has_last_ = true;
+  last_com_ = com;
+  last_plan_com_ = plan_com;
+
+  struct Foot {
+    int spot;
+    Eigen::Isometry3d pose;   // the planned spot frame (z into the foot)
+    bool supporting;
+    double force = 0;         // measured, along the normal
+    double want = 0;
+    Eigen::Vector2d cop = Eigen::Vector2d::Zero(), want_cop = Eigen::Vector2d::Zero();  // spot frame
+  };
+  std::vector<Foot> down;
+  for (const ContactSpec& c : contacts)
+    if (isFootSpot(m, c.spot)) down.push_back({c.spot, kin_.spotPose(c.spot), c.supporting});
+
+  std::vector<bool> regulated(m.spots().size(), false);
+  if (on && !down.empty()) {
+    zmp_ = plan_com.head<2>() + opt_.zmp_com_gain * (com - plan_com).head<2>() +
+           opt_.zmp_velocity_gain * com_velocity_.head<2>();
+    double total = 0;
+    for (Foot& f : down) {
+      const SpotWrench& w = wrenches[f.spot];
+      const Eigen::Matrix3d R = f.pose.linear();
+      const Eigen::Vector3d F = R.transpose() * w.force, M = R.transpose() * w.moment;
+      f.force = std::max(F.z(), 0.0);
+      if (F.z() > 1.0) f.cop = Eigen::Vector2d(-M.y() / F.z(), M.x() / F.z());
+      total += f.force;
+    }
+    std::vector<Foot*> sup;
+    for (Foot& f : down)
+      if (f.supporting) sup.push_back(&f);
+    // Where the wanted ZMP puts each supporting foot's load and centre of
+    // pressure (world x-y), then in the foot's frame.
+    auto wantAt = [&](Foot& f, double share, const Eigen::Vector2d& p) {
+      f.want = share * total;
+      const Eigen::Vector3d local = f.pose.inverse() * Eigen::Vector3d(p.x(), p.y(), f.pose.translation().z());
+      f.want_cop = nearestIn(m.spots()[f.spot].polygon.inset(opt_.cop_edge), local.head<2>());
+    };
+    if (sup.size() == 1) {
+      wantAt(*sup[0], 1.0, zmp_);
+    } else if (sup.size() >= 2) {
+      const Eigen::Vector2d a = sup[0]->pose.translation().head<2>(), b = sup[1]->pose.translation().head<2>();
+      const Eigen::Vector2d ab = b - a;
+      const double lambda = ab.squaredNorm() > 1e-12 ? std::clamp((zmp_ - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.5;
+      const Eigen::Vector2d off = zmp_ - (a + lambda * ab);
+      wantAt(*sup[0], 1 - lambda, a + off);
+      wantAt(*sup[1], lambda, b + off);
+    }
+    for (Foot& f : down) {
+      double& z = lift_[f.spot];
+      Eigen::Vector2d& th = tilt_[f.spot];
+      if (down.size() >= 2) z = step(z, (f.force - f.want) / opt_.force_damping - z / opt_.force_leak, dt, opt_.max_lift);
+      else z *= std::exp(-dt / opt_.force_leak);
+      if (f.supporting && f.force > 1.0) {
+        // Turning about the foot's +y by a > 0 presses its toe (+x) down;
+        // about its +x by b > 0 lifts its +y side.
+        const Eigen::Vector2d e = f.want_cop - f.cop;
+        th.x() = step(th.x(), -opt_.cop_gain * e.y() - th.x() / opt_.cop_leak, dt, opt_.max_tilt);
+        th.y() = step(th.y(), opt_.cop_gain * e.x() - th.y() / opt_.cop_leak, dt, opt_.max_tilt);
+      } else {
+        th *= std::exp(-dt / opt_.cop_leak);
+      }
+      regulated[f.spot] = true;
+    }
+  }
+  for (int s : feet_)
+    if (!regulated[s]) {
+      lift_[s] *= std::exp(-dt / opt_.off_time);
+      tilt_[s] *= std::exp(-dt / opt_.off_time);
+    }
+
+  // Joint offsets: each foot moved by its rise and turned by its tilt
+  // relative to the waist, through the leg's Jacobian (damped least squares,
+  // so that a stretched knee does not blow them up).
+  Eigen::VectorXd dq = Eigen::VectorXd::Zero(m.numJoints());
+  for (std::size_t k = 0; k < feet_.size(); ++k) {
+    const int s = feet_[k];
+    if (std::abs(lift_[s]) < 1e-9 && tilt_[s].norm() < 1e-9) continue;
+    const ContactSpot& spot = m.spots()[s];
+    const Eigen::Isometry3d pose = kin_.spotPose(s);
+    Eigen::Matrix<double, 6, 1> d;
+    d.head<3>() = lift_[s] * pose.linear().col(2);
+    d.tail<3>() = pose.linear() * Eigen::Vector3d(tilt_[s].x(), tilt_[s].y(), 0);
+    const Eigen::MatrixXd J = kin_.frameJacobian(spot.link, spot.frame.translation());
+    const std::vector<int>& leg = leg_[k];
+    Eigen::MatrixXd Jl(6, leg.size());
+    for (std::size_t i = 0; i < leg.size(); ++i) Jl.col(i) = J.col(6 + leg[i]);
+    const Eigen::MatrixXd A = Jl * Jl.transpose() + 1e-6 * Eigen::MatrixXd::Identity(6, 6);
+    const Eigen::VectorXd x = Jl.transpose() * A.ldlt().solve(d);
+    for (std::size_t i = 0; i < leg.size(); ++i) dq[leg[i]] += x[i];
+  }
+  return dq;
+}
+
+}  // namespace acyclic::hrp2
