@@ -47,6 +47,7 @@ std::string validateOptions(const InterpolatorOptions& o) {
   if (!(o.support_inset >= 0 && o.support_inset < 0.1)) return "the support inset must be in [0, 0.1) m";
   if (!(o.support_inset_y < 0.1)) return "the support inset across must be below 0.1 m (negative: the support inset)";
   if (!(o.friction_share > 0 && o.friction_share <= 1)) return "the friction share must be in (0, 1]";
+  if (!(o.zmp_shift_cap >= 0 && std::isfinite(o.zmp_shift_cap))) return "the ZMP shift cap must be >= 0 m and finite";
   if (!(o.link_acceleration_cap > 0 && std::isfinite(o.link_acceleration_cap)))
     return "the link acceleration cap must be positive and finite";
   if (!(o.velocity_share > 0 && o.velocity_share <= 1)) return "the velocity share must be in (0, 1]";
@@ -96,6 +97,7 @@ TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
   to.posture.ipopt_options = opt.posture_ipopt_options;
   to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};
+  to.timing.zmp_shift_cap = opt.zmp_shift_cap;
   to.verify_samples = opt.verify_samples;
   return to;
 }

@@ -23,6 +23,7 @@ struct InterpolatorOptions {
   double speed_cap = 0.2;        // m/s, any link origin (quasi-static motion)
   double velocity_share = 0.9;   // of each joint's velocity limit
   double link_acceleration_cap = 1.0;  // m/s^2, any link origin (time_law.h); joints: the robot's limits
+  double zmp_shift_cap = 0;            // m, the ZMP's shift by the motion's accelerations (time_law.h); 0: none
   bool filter = true;            // drop stances whose direct transition is valid
   double lift = 0.03;            // m: straight along the normal when leaving and reaching a surface
   double touch_clearance = 5e-4; // m: a body this far off its surface has left it

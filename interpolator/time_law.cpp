@@ -65,6 +65,19 @@ TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel
     }
     double link_arc = 0;
     for (int l = 0; l < robot.numLinks(); ++l) link_arc = std::max(link_arc, arc[l]);
+    // The ZMP's shift per unit u'': sum_l m_l h_l (arc_l / len) / (M g),
+    // heights at the segment's start above its lowest link origin.
+    double zmp_moment = 0;
+    if (opt.zmp_shift_cap > 0) {
+      const std::vector<Eigen::Vector3d> o = origins(knots_[k]);
+      double lowest = std::numeric_limits<double>::infinity(), mass = 0;
+      for (const auto& x : o) lowest = std::min(lowest, x.z());
+      for (int l = 0; l < robot.numLinks(); ++l) {
+        zmp_moment += robot.links()[l].mass * (o[l].z() - lowest) * arc[l];
+        mass += robot.links()[l].mass;
+      }
+      zmp_moment /= mass * 9.81;
+    }
     len = std::max(len, link_arc / opt.speed_cap);
     p.length = len;
     if (len <= 0) continue;
@@ -74,6 +87,7 @@ TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel
     for (const auto& j : robot.joints())
       if (slope_[k][j.index] != 0) A = std::min(A, 0.5 * jointAccel(j) / std::abs(slope_[k][j.index]));
     if (link_arc > 0) A = std::min(A, opt.link_acceleration_cap * len / link_arc);
+    if (zmp_moment > 0) A = std::min(A, opt.zmp_shift_cap * len / zmp_moment);
     p.accel = A;
   }
 

@@ -7,6 +7,11 @@
 // - acceleration: every joint within half its acceleration limit
 //   (RobotModel, JointInfo::acceleration) inside a segment, every link origin
 //   within a linear acceleration cap;
+// - balance (optional): the zero-moment point moved by the links'
+//   accelerations at most zmp_shift_cap from where the quasi-static plan has
+//   it, estimated per segment as sum_l m_l h_l |a_l| / (M g) (h_l a link
+//   origin's height above the lowest link origin, |a_l| its acceleration
+//   along the path; vertical accelerations and rotational inertia left out);
 // - corners: at a knot where the polyline turns, the speed is low enough that
 //   each joint's velocity jumps by at most half its acceleration limit times
 //   dt.
@@ -32,6 +37,10 @@ struct TimeLawOptions {
   // m/s^2, any link origin: about a tenth of gravity, so that inertial
   // forces stay small beside the weight the quasi-static check balances.
   double link_acceleration_cap = 1.0;
+  // m: the ZMP's shift by the motion's accelerations at most this (0: no
+  // such bound). 0.01 lets the CoM accelerate at about 0.12 m/s^2 when it is
+  // 0.8 m high and nothing else moves.
+  double zmp_shift_cap = 0;
   // Scales every joint's acceleration limit (1: the model's); for
   // experiments and tests that isolate the velocity bounds.
   double acceleration_scale = 1.0;

@@ -65,6 +65,10 @@ int main(int argc, char** argv) {
   auto* share_flag = app.add_option("--friction-share", o.friction_share,
                  "stability margin of the knots: the share of each surface's friction coefficient used, in (0, 1] "
                  "(default: the scenario's planner key posture_friction_share, else 1)");
+  app.add_option("--zmp-shift-cap", o.zmp_shift_cap,
+                 "largest shift of the zero-moment point by the motion's accelerations, m (0: no such bound; 0.01 "
+                 "slows a whole-body sway to about 0.12 m/s^2)")
+      ->capture_default_str();
   app.add_option("--link-acceleration-cap", o.link_acceleration_cap,
                  "largest acceleration of any link origin, m/s^2 (joints: the robot file's acceleration_limits)")
       ->capture_default_str();
