@@ -355,6 +355,31 @@ TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEach
   EXPECT_NE(n.reason.find("no path"), std::string::npos) << n.reason;
 }
 
+// A limb whose straight interpolation is clear gets it, checked before any
+// search (RRTConnect grows toward random samples and missed such a path 3 mm
+// clear in a narrow passage): two waypoints, the witnesses' values, even with
+// no budget for OMPL.
+TEST(LimbPathPlanner, AClearStraightPathIsTakenWithoutSearching) {
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
+  const Configuration& q0 = plan.stances[0].configuration;  // the hand hanging in front of the table
+  Configuration q1 = q0;
+  const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_palm"));
+  for (int j : sc.robot->jointsMovedBy(root)) q1.joints[j] += 0.03;
+  const CollisionModel collisions(sc.robot, sc.scene);
+  Kinematics kin(sc.robot);
+  ASSERT_GT(limbSweepClearance(collisions, kin, root, q0, q1, 0.05), 0.012);
+  LimbPathPlanOptions none;
+  none.max_checks = 1;
+  const LimbPathPlan p = planLimbPath(collisions, kin, root, q0, q1, none);
+  ASSERT_TRUE(p.path) << p.reason;
+  ASSERT_EQ(p.path->waypoints().size(), 2u);
+  const LimbJointPath straight = straightLimbPath(*sc.robot, root, q0, q1);
+  EXPECT_EQ(p.path->waypoints().front(), straight.waypoints().front());
+  EXPECT_EQ(p.path->waypoints().back(), straight.waypoints().back());
+  EXPECT_EQ(p.path->apply(q0, 0.5).joints, straight.apply(q0, 0.5).joints);
+}
+
 TEST(LimbPathPlanner, AForearmOnTheTableIsTouchingAtItsEndOnlyWhenToldSo) {
   // From a plan of the paper's chair: seated on the left thigh, the left
   // forearm leaves the table, and the arm hangs below the table's top in the
