@@ -104,6 +104,53 @@ TEST(FeetStabilizer, ASoleLoadedBehindTheWantedPointTurnsItsToeDown) {
   for (const std::string j : {"RLEG_JOINT2", "RLEG_JOINT3", "RLEG_JOINT4"}) EXPECT_EQ(dq[sc.robot->jointIndex(j)], 0.0) << j;
 }
 
+// Staggered feet (5.4 cm), the wanted ZMP 7 mm behind the front sole's heel
+// and in line with it (as in a chair plan's double support): the loads and
+// centres of pressure the soles are asked for combine to the ZMP, each inside
+// its sole, and the rear sole takes over a fifth of the load (22%). Sharing by
+// where the ZMP lies between the ankles gave it 12%, leaving the front heel
+// to hold the rest.
+TEST(FeetStabilizer, StaggeredFeetShareAZmpBehindTheFrontHeelWithTheRearSole) {
+  const Scenario& sc = standing();
+  const RobotModel& m = *sc.robot;
+  Configuration q = sc.start;
+  q.joints[m.jointIndex("LLEG_JOINT2")] -= 0.1;  // the left foot forward, kept level
+  q.joints[m.jointIndex("LLEG_JOINT4")] += 0.1;
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(q);
+  const Eigen::Isometry3d front = kin.spotPose(spot("l_sole")), rear = kin.spotPose(spot("r_sole"));
+  ASSERT_GT(front.translation().x() - rear.translation().x(), 0.03);
+  const Eigen::Vector3d heel = front * Eigen::Vector3d(-0.077, 0, 0);
+  const Eigen::Vector2d zmp(heel.x() - 0.007, heel.y());
+  // The measured CoM that makes the wanted ZMP that point (no velocity).
+  const hrp2::FeetStabilizerOptions o;
+  const Eigen::Vector3d plan_com = kin.centerOfMass();
+  Eigen::Vector3d com = plan_com;
+  com.head<2>() += (zmp - plan_com.head<2>()) / o.zmp_com_gain;
+  std::vector<hrp2::SpotWrench> w(m.spots().size());
+  w[spot("l_sole")] = soleWrench(q, "l_sole", 570, {-0.07, 0});
+  w[spot("r_sole")] = soleWrench(q, "r_sole", 0, {0, 0});
+  hrp2::FeetStabilizer st(sc.robot, sc.scene, o);
+  for (int k = 0; k < 10; ++k) st.update(0.005, true, q, sc.start_stance, com, w);
+  EXPECT_LT((st.wantedZmp() - zmp).norm(), 1e-6);
+  // The soles' wanted loads and centres of pressure put the combined centre
+  // of pressure at the ZMP, each inside its sole, the rear sole taking a share.
+  const int l = spot("l_sole"), r = spot("r_sole");
+  const double total = st.wantedLoad(l) + st.wantedLoad(r);
+  EXPECT_NEAR(total, 570, 1e-6);
+  const Eigen::Vector2d combined = (st.wantedLoad(l) * st.wantedCop(l) + st.wantedLoad(r) * st.wantedCop(r)) / total;
+  EXPECT_LT((combined - zmp).norm(), 1e-4) << combined.transpose() << " vs " << zmp.transpose();
+  EXPECT_GT(st.wantedLoad(r), 0.17 * total);
+  for (int s : {l, r}) {
+    const Eigen::Isometry3d X = kin.spotPose(s);
+    const Eigen::Vector3d local = X.inverse() * Eigen::Vector3d(st.wantedCop(s).x(), st.wantedCop(s).y(), X.translation().z());
+    EXPECT_TRUE(m.spots()[s].polygon.contains(local.head<2>(), 1e-9)) << m.spots()[s].name;
+  }
+  // Measured with the whole load on the front sole: it rises, the rear one is pressed down.
+  EXPECT_GT(st.lift(l), 1e-5);
+  EXPECT_LT(st.lift(r), -1e-5);
+}
+
 TEST(FeetStabilizer, BadOptionsAreRefusedByName) {
   hrp2::FeetStabilizerOptions o;
   o.force_damping = 0;

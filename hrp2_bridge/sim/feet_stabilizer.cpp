@@ -40,6 +40,8 @@ FeetStabilizer::FeetStabilizer(std::shared_ptr<const RobotModel> robot, std::sha
   const RobotModel& m = *robot_;
   lift_.assign(m.spots().size(), 0.0);
   tilt_.assign(m.spots().size(), Eigen::Vector2d::Zero());
+  want_load_.assign(m.spots().size(), 0.0);
+  want_cop_.assign(m.spots().size(), Eigen::Vector2d::Zero());
   for (int s = 0; s < static_cast<int>(m.spots().size()); ++s) {
     if (!isFootSpot(m, s)) continue;
     std::vector<int> chain;
@@ -75,6 +77,62 @@ Eigen::Vector2d nearestIn(const ConvexPolygon& poly, const Eigen::Vector2d& p) {
   return best;
 }
 
+// The convex hull of points, counter-clockwise (Andrew's monotone chain).
+std::vector<Eigen::Vector2d> hull(std::vector<Eigen::Vector2d> p) {
+  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Eigen::Vector2d> h(2 * p.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (std::size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(h[k - 2], h[k - 1], p[i - 1]) <= 0) --k;
+    h[k++] = p[i - 1];
+  }
+  h.resize(k > 1 ? k - 1 : k);
+  return h;
+}
+
+// Weights w >= 0 on the points p, summing to 1, with sum w_i p_i = z, of
+// least norm (the load spread as evenly as the points allow): z is first
+// moved into the points' hull, then an active-set iteration drops the most
+// negative weight and solves again. Empty if it does not settle.
+std::vector<double> spreadWeights(const std::vector<Eigen::Vector2d>& p, Eigen::Vector2d z) {
+  const std::vector<Eigen::Vector2d> h = hull(p);
+  if (h.size() < 3) return {};
+  z = nearestIn(ConvexPolygon(h), z);
+  const int n = static_cast<int>(p.size());
+  std::vector<bool> active(n, true);
+  for (int round = 0; round < n; ++round) {
+    std::vector<int> idx;
+    for (int i = 0; i < n; ++i)
+      if (active[i]) idx.push_back(i);
+    if (idx.size() < 3) return {};
+    Eigen::MatrixXd A(3, idx.size());
+    for (std::size_t j = 0; j < idx.size(); ++j) A.col(j) << 1.0, p[idx[j]].x(), p[idx[j]].y();
+    const Eigen::Matrix3d AAt = A * A.transpose();
+    Eigen::LDLT<Eigen::Matrix3d> ldlt(AAt);
+    if (ldlt.info() != Eigen::Success || std::abs(AAt.determinant()) < 1e-15) return {};
+    const Eigen::VectorXd w = A.transpose() * ldlt.solve(Eigen::Vector3d(1.0, z.x(), z.y()));
+    int worst = -1;
+    for (std::size_t j = 0; j < idx.size(); ++j)
+      if (w[j] < -1e-12 && (worst < 0 || w[j] < w[worst])) worst = static_cast<int>(j);
+    if (worst < 0) {
+      std::vector<double> out(n, 0.0);
+      for (std::size_t j = 0; j < idx.size(); ++j) out[idx[j]] = std::max(0.0, w[j]);
+      return out;
+    }
+    active[idx[worst]] = false;
+  }
+  return {};
+}
+
 }  // namespace
 
 Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& plan,
@@ -108,6 +166,7 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
     if (isFootSpot(m, c.spot)) down.push_back({c.spot, kin_.spotPose(c.spot), c.supporting});
 
   std::vector<bool> regulated(m.spots().size(), false);
+  std::fill(want_load_.begin(), want_load_.end(), 0.0);
   if (on && !down.empty()) {
     zmp_ = plan_com.head<2>() + opt_.zmp_com_gain * (com - plan_com).head<2>() +
            opt_.zmp_velocity_gain * com_velocity_.head<2>();
@@ -133,12 +192,41 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
     if (sup.size() == 1) {
       wantAt(*sup[0], 1.0, zmp_);
     } else if (sup.size() >= 2) {
-      const Eigen::Vector2d a = sup[0]->pose.translation().head<2>(), b = sup[1]->pose.translation().head<2>();
-      const Eigen::Vector2d ab = b - a;
-      const double lambda = ab.squaredNorm() > 1e-12 ? std::clamp((zmp_ - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.5;
-      const Eigen::Vector2d off = zmp_ - (a + lambda * ab);
-      wantAt(*sup[0], 1 - lambda, a + off);
-      wantAt(*sup[1], lambda, b + off);
+      // The wanted ZMP spread over the corners of the supporting soles
+      // (shrunk by cop_edge) with weights of least norm: each sole's share is
+      // its corners' weights, its centre of pressure their weighted mean. So
+      // staggered feet share as the plan's statics do, the front sole not
+      // left to hold a ZMP behind its heel alone.
+      std::vector<Eigen::Vector2d> corners;
+      std::vector<int> owner;
+      for (std::size_t k = 0; k < sup.size(); ++k) {
+        const ConvexPolygon shrunk = m.spots()[sup[k]->spot].polygon.inset(opt_.cop_edge);
+        for (const Eigen::Vector2d& v : shrunk.vertices()) {
+          corners.push_back((sup[k]->pose * Eigen::Vector3d(v.x(), v.y(), 0)).head<2>());
+          owner.push_back(static_cast<int>(k));
+        }
+      }
+      const std::vector<double> w = spreadWeights(corners, zmp_);
+      if (!w.empty()) {
+        for (std::size_t k = 0; k < sup.size(); ++k) {
+          double share = 0;
+          Eigen::Vector2d at = Eigen::Vector2d::Zero();
+          for (std::size_t i = 0; i < corners.size(); ++i)
+            if (owner[i] == static_cast<int>(k)) share += w[i], at += w[i] * corners[i];
+          wantAt(*sup[k], share, share > 1e-9 ? Eigen::Vector2d(at / share) : sup[k]->pose.translation().head<2>());
+        }
+      } else {
+        const Eigen::Vector2d a = sup[0]->pose.translation().head<2>(), b = sup[1]->pose.translation().head<2>();
+        const Eigen::Vector2d ab = b - a;
+        const double lambda = ab.squaredNorm() > 1e-12 ? std::clamp((zmp_ - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.5;
+        const Eigen::Vector2d off = zmp_ - (a + lambda * ab);
+        wantAt(*sup[0], 1 - lambda, a + off);
+        wantAt(*sup[1], lambda, b + off);
+      }
+    }
+    for (const Foot& f : down) {
+      want_load_[f.spot] = f.want;
+      want_cop_[f.spot] = (f.pose * Eigen::Vector3d(f.want_cop.x(), f.want_cop.y(), 0)).head<2>();
     }
     for (Foot& f : down) {
       double& z = lift_[f.spot];

@@ -17,9 +17,14 @@
 //   linear inverted pendulum's state feedback; the real robot estimates them
 //   from its IMU and encoders, here they are the simulation's);
 // - distribution: a single supporting foot takes the whole load with its
-//   centre of pressure at the wanted ZMP; two share the load by where the ZMP
-//   lies between their origins, each offset by the ZMP's distance from the
-//   segment joining them; a foot touching but not supporting wants no load;
+//   centre of pressure at the wanted ZMP; two or more spread it over their
+//   soles' corners (shrunk by cop_edge) with weights of least norm that put
+//   the combined centre of pressure at the ZMP (the ZMP first moved into the
+//   corners' hull): a sole's share is its corners' weights, its centre of
+//   pressure their weighted mean. Staggered feet so share as the plan's
+//   statics do (a ZMP just behind the front heel is held mostly by the rear
+//   sole), where sharing by the ZMP's place between the soles' origins left
+//   the front heel alone. A foot touching but not supporting wants no load;
 // - foot damping control: each foot on the ground rises along its normal at
 //   (f - f*) / force_damping (only when two or more feet are down: a single
 //   foot's force is the weight) and turns about its own x and y axes at
@@ -76,6 +81,10 @@ class FeetStabilizer {
   double lift(int spot) const { return lift_.at(spot); }             // m, a foot's rise
   Eigen::Vector2d tilt(int spot) const { return tilt_.at(spot); }    // rad, a foot's turn about its x and y
   Eigen::Vector2d wantedZmp() const { return zmp_; }                 // world x-y, the last period's
+  // The last period's wanted normal force on a sole and its wanted centre of
+  // pressure (world x-y); zero for a sole not down.
+  double wantedLoad(int spot) const { return want_load_.at(spot); }
+  Eigen::Vector2d wantedCop(int spot) const { return want_cop_.at(spot); }
 
  private:
   std::shared_ptr<const RobotModel> robot_;
@@ -86,6 +95,8 @@ class FeetStabilizer {
   std::vector<std::vector<int>> leg_;     // per foot: its joints, base to foot
   std::vector<double> lift_;              // per spot
   std::vector<Eigen::Vector2d> tilt_;     // per spot
+  std::vector<double> want_load_;         // per spot
+  std::vector<Eigen::Vector2d> want_cop_; // per spot, world x-y
   Eigen::Vector2d zmp_ = Eigen::Vector2d::Zero();
   // Centre-of-mass velocities by differences, measured and planned.
   bool has_last_ = false;
