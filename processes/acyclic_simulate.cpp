@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
       for (const auto& c : p.contacts) {
         std::printf("  %-10s @ %-12s %-10s slip %5.1f mm, lift %5.1f mm, unloaded %.2f s%s, force (%.0f %.0f %.0f) N",
                     c.spot.c_str(), c.surface.c_str(), c.supporting ? "supporting" : "touching", 1e3 * c.slip,
-                    1e3 * c.lift, c.unloaded_time, c.left_surface ? ", LEFT THE SURFACE" : "", c.force.x(),
+                    1e3 * c.lift, c.unloaded_time, c.never_loaded ? ", NEVER LOADED" : c.left_surface ? ", LEFT THE SURFACE" : "", c.force.x(),
                     c.force.y(), c.force.z());
         if (c.plan_force_known)
           std::printf(", plan (%.0f %.0f %.0f) N\n", c.plan_force.x(), c.plan_force.y(), c.plan_force.z());

@@ -135,6 +135,29 @@ TEST(DynamicsSimulation, LeaningWithinTheFeetStaysUp) {
   expectExecuted(r);
 }
 
+// A contact the plan says supports but that never touches (here a palm on
+// the floor while the robot stands and leans 3 degrees) is reported as never
+// loaded, and the verdict says it never reached its surface rather than
+// that it slipped.
+TEST(DynamicsSimulation, ASupportingContactThatNeverTouchesIsReportedAsSuch) {
+  const Scenario& sc = floorScenario();
+  Trajectory tr = leaningTrajectory(sc, 3 * M_PI / 180);
+  ContactSpec palm = tr.phases[0].contacts[0];
+  palm.spot = sc.robot->spotIndex("l_palm");
+  palm.supporting = true;
+  tr.phases[0].contacts.push_back(palm);
+  const hrp2::SimulationReport r = hrp2::simulate(sc, tr);
+  ASSERT_EQ(r.phases.size(), 1u);
+  const auto& contacts = r.phases[0].contacts;
+  ASSERT_EQ(contacts.size(), 3u);
+  EXPECT_TRUE(contacts[2].never_loaded);
+  EXPECT_FALSE(contacts[0].never_loaded);
+  EXPECT_FALSE(contacts[1].never_loaded);
+  EXPECT_EQ(r.verdict, hrp2::SimulationReport::Verdict::Slipped) << r.reason;
+  EXPECT_NE(r.reason.find("l_palm on floor carried no load"), std::string::npos) << r.reason;
+  EXPECT_NE(hrp2::reportToJson(r).find("\"never_loaded\": true"), std::string::npos);
+}
+
 TEST(DynamicsSimulation, CentreOfMassBeyondTheToesFalls) {
   // 20 degrees: the CoM about 28 cm ahead of the ankles, twice the toes' 14 cm.
   const Scenario& sc = floorScenario();

@@ -545,9 +545,15 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
       if (co.supporting && !sf.polygon.contains(local.head<2>())) co.left_surface = true;
       if (co.supporting && slip_time < 0 && (co.slip > options.slip_bound || co.left_surface)) {
         slip_time = t1;
-        char buf[200];
+        char buf[300];
+        // A contact that has carried nothing since its phase began did not
+        // slip: it never reached its surface (a palm above a table the
+        // robot leans away from), which is the thing to say.
+        const bool unloaded = co.unloaded_time >= t1 - po.t_start - 0.5 * dt;
         std::snprintf(buf, sizeof buf, "%s on %s %s in phase %d (%.1f mm)", co.spot.c_str(), co.surface.c_str(),
-                      co.left_surface ? "left the surface" : "slipped beyond the bound", phase, 1e3 * co.slip);
+                      unloaded ? "carried no load since the phase began (it never reached its surface) and moved"
+                               : co.left_surface ? "left the surface" : "slipped beyond the bound",
+                      phase, 1e3 * co.slip);
         slip_reason = buf;
       }
     }
@@ -592,6 +598,9 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
       rep.verdict_time = rep.motion_time;
     }
   }
+  for (auto& p : rep.phases)
+    for (auto& c : p.contacts)
+      c.never_loaded = c.supporting && p.t_end - p.t_start > dt && c.unloaded_time >= p.t_end - p.t_start - 0.5 * dt;
   for (const auto& p : rep.phases) {
     rep.worst_base_drift = std::max(rep.worst_base_drift, p.base_drift);
     if (p.tracking > rep.worst_tracking) rep.worst_tracking = p.tracking, rep.worst_tracking_joint = p.tracking_joint;
@@ -652,7 +661,7 @@ std::string reportToJson(const SimulationReport& r) {
     json cs = json::array();
     for (const auto& c : p.contacts) {
       json jc = {{"spot", c.spot}, {"surface", c.surface}, {"supporting", c.supporting}, {"slip", c.slip},
-                 {"lift", c.lift}, {"unloaded_time", c.unloaded_time}, {"left_surface", c.left_surface},
+                 {"lift", c.lift}, {"unloaded_time", c.unloaded_time}, {"never_loaded", c.never_loaded}, {"left_surface", c.left_surface},
                  {"force", vec(c.force)}};
       jc["plan_force"] = c.plan_force_known ? vec(c.plan_force) : json(nullptr);
       cs.push_back(jc);

@@ -75,6 +75,7 @@ struct ContactOutcome {
   double lift = 0;                   // m, largest height of the spot's origin above its start, along the normal
   double unloaded_time = 0;          // s, time within the phase with no contact force on the spot
   bool left_surface = false;         // the spot's origin left the surface polygon
+  bool never_loaded = false;         // supporting in the plan, no force on it through the whole phase
   Eigen::Vector3d force = Eigen::Vector3d::Zero();       // N, world, simulated, at the phase's middle sample
   Eigen::Vector3d plan_force = Eigen::Vector3d::Zero();  // N, world, quasi-static LP at the same sample
   bool plan_force_known = false;     // the LP found forces there
