@@ -57,7 +57,8 @@ TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel
       len = std::max(len, std::abs(knots_[k + 1].joints[j.index] - knots_[k].joints[j.index]) /
                               (opt.velocity_share * j.velocity));
     std::vector<double> arc(robot.numLinks(), 0.0);
-    std::vector<Eigen::Vector3d> prev = origins(knots_[k]);
+    const std::vector<Eigen::Vector3d> first = origins(knots_[k]);
+    std::vector<Eigen::Vector3d> prev = first;
     for (int i = 1; i <= kSub; ++i) {
       const std::vector<Eigen::Vector3d> cur = origins(lerp(knots_[k], knots_[k + 1], static_cast<double>(i) / kSub));
       for (int l = 0; l < robot.numLinks(); ++l) arc[l] += (cur[l] - prev[l]).norm();
@@ -69,14 +70,10 @@ TimedPiece::TimedPiece(const std::vector<Configuration>& knots, const RobotModel
     // heights at the segment's start above its lowest link origin.
     double zmp_moment = 0;
     if (opt.zmp_shift_cap > 0) {
-      const std::vector<Eigen::Vector3d> o = origins(knots_[k]);
-      double lowest = std::numeric_limits<double>::infinity(), mass = 0;
-      for (const auto& x : o) lowest = std::min(lowest, x.z());
-      for (int l = 0; l < robot.numLinks(); ++l) {
-        zmp_moment += robot.links()[l].mass * (o[l].z() - lowest) * arc[l];
-        mass += robot.links()[l].mass;
-      }
-      zmp_moment /= mass * 9.81;
+      double lowest = std::numeric_limits<double>::infinity();
+      for (const auto& x : first) lowest = std::min(lowest, x.z());
+      for (int l = 0; l < robot.numLinks(); ++l) zmp_moment += robot.links()[l].mass * (first[l].z() - lowest) * arc[l];
+      zmp_moment /= robot.totalMass() * 9.81;
     }
     len = std::max(len, link_arc / opt.speed_cap);
     p.length = len;

@@ -114,7 +114,7 @@ void DynamicsOptions::validate() const {
   positive(base_bound, "base_bound");
   if (!(dissipation >= 0)) throw std::invalid_argument("dissipation must be >= 0");
   if (integrator != "rk-merson" && integrator != "rk3" && integrator != "semi-explicit-euler2" && integrator != "cpodes")
-    throw std::invalid_argument("integrator must be rk-merson, rk3 or semi-explicit-euler2 (got " + integrator + ")");
+    throw std::invalid_argument("integrator must be cpodes, semi-explicit-euler2, rk-merson or rk3 (got " + integrator + ")");
   if (!(settle >= 0)) throw std::invalid_argument("settle must be >= 0");
   stabilizer_options.validate();
 }

@@ -63,18 +63,7 @@ double step(double x, double rate, double dt, double bound) { return std::clamp(
 
 // The point of a convex polygon nearest to p (p itself when inside).
 Eigen::Vector2d nearestIn(const ConvexPolygon& poly, const Eigen::Vector2d& p) {
-  if (poly.contains(p)) return p;
-  const auto& v = poly.vertices();
-  Eigen::Vector2d best = v.front();
-  double best_d = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
-    const double len2 = (b - a).squaredNorm();
-    const double s = len2 > 0 ? std::clamp((p - a).dot(b - a) / len2, 0.0, 1.0) : 0.0;
-    const Eigen::Vector2d q = a + s * (b - a);
-    if ((q - p).norm() < best_d) best_d = (q - p).norm(), best = q;
-  }
-  return best;
+  return poly.contains(p) ? p : poly.nearestBoundaryPoint(p);
 }
 
 // The convex hull of points, counter-clockwise (Andrew's monotone chain).
