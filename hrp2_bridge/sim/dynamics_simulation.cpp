@@ -480,6 +480,10 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
     stabilizer_on = scheduleStabilizer(tr, m, *sc.scene, BridgeConfig{}).sample_on;
   }
   Eigen::VectorXd offset_from = Eigen::VectorXd::Zero(m.numJoints()), offset_to = offset_from;
+  // Measured once per period, after it is integrated: the contact wrenches
+  // and CoM the report reads are those the next period's stabilizer update takes.
+  std::vector<SpotWrench> wrenches = S.spotWrenches();
+  Eigen::Vector3d com = sim.centerOfMass();
 
   bool fell = false;
   double last_progress = -1;
@@ -491,7 +495,7 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
     if (stabilizer) {
       const bool on = stabilizer_on[std::min(k, N - 1)];
       offset_from = offset_to;
-      offset_to = stabilizer->update(dt, on, to.q, tr.phases[to.phase].contacts, sim.centerOfMass(), S.spotWrenches());
+      offset_to = stabilizer->update(dt, on, to.q, tr.phases[to.phase].contacts, com, wrenches);
       if (on && k < N) rep.stabilizer_on_time += dt;
       for (int s = 0; s < static_cast<int>(m.spots().size()); ++s) {
         rep.stabilizer_max_tilt = std::max(rep.stabilizer_max_tilt, stabilizer->tilt(s).norm());
@@ -521,7 +525,10 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
     // Contacts.
     const auto& contacts = tr.phases[phase].contacts;
     const bool at_middle = k == middle[phase];
-    std::vector<Eigen::Vector3d> f = S.spotForces();
+    wrenches = S.spotWrenches();
+    com = sim.centerOfMass();
+    std::vector<Eigen::Vector3d> f;
+    for (const SpotWrench& w : wrenches) f.push_back(w.force);
     if (at_middle) {
       kin.setConfiguration(to.q);
       const QuasiStaticReport qs = lp.check(kin, contacts);
@@ -562,7 +569,7 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
       ts.t = t1;
       ts.phase = phase;
       ts.stabilizer_on = stabilizer && stabilizer_on[std::min(k, N - 1)];
-      ts.com = sim.centerOfMass();
+      ts.com = com;
       kin.setConfiguration(to.q);
       ts.plan_com = kin.centerOfMass();
       ts.base = q.base_position;
