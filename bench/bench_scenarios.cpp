@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (verify) p.verify_transitions = true;
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
-    attachPlanVerifier(p, sc, withScenarioMargins(sc, {}));
+    attachPlanVerifier(p, sc);
 #endif
     const PlanningResult r = ContactPlanner(sc, p).plan();
     std::string verdict = "-", used;

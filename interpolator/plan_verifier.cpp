@@ -120,4 +120,8 @@ void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const Interpol
   if (p.verify_transitions && !p.verify_plan) p.verify_plan = makePlanVerifier(sc, options);
 }
 
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc) {
+  attachPlanVerifier(p, sc, withScenarioMargins(sc, {}));
+}
+
 }  // namespace acyclic

@@ -42,7 +42,10 @@ class TransitionVerifier {
 // TransitionVerifier (the planner may copy it).
 PlanVerifier makePlanVerifier(const Scenario& sc, const InterpolatorOptions& options = {});
 
-// Gives p a verifier when p.verify_transitions is set and it has none.
-void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options = {});
+// Gives p a verifier when p.verify_transitions is set and it has none:
+// with these options, or by default the interpolator's with the scenario's
+// margins (withScenarioMargins), as the interpolator will solve them.
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options);
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc);
 
 }  // namespace acyclic

@@ -49,7 +49,7 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   if (verify_transitions >= 0) p.verify_transitions = verify_transitions == 1;
   else if (!scenario_says) p.verify_transitions = kVerifyTransitionsByDefault;
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
-  attachPlanVerifier(p, sc, withScenarioMargins(sc, {}));
+  attachPlanVerifier(p, sc);
 #else
   if (p.verify_transitions)
     throw std::invalid_argument("verify_transitions: this build has no interpolator to verify transitions with");
