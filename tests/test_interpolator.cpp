@@ -314,20 +314,33 @@ TEST(BodyPathPlanner, PlansAFootOverABoxClearOfItTheSameEachTime) {
   EXPECT_NE(none.reason.find("no path"), std::string::npos) << none.reason;
 }
 
+namespace {
+// The chair plan's free left arm going over the table's edge
+// (tests/data/chair_ompl_arm_over_edge.plan.json), with what a limb planner
+// needs there: the collision model, a Kinematics and the arm's root joint.
+struct ArmOverEdge {
+  const Scenario& sc = chairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
+  const CollisionModel collisions{sc.robot, sc.scene};
+  Kinematics kin{sc.robot};
+  const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_palm"));
+};
+}  // namespace
+
 TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEachTime) {
   // From a plan of the chair with its OMPL guide: on the left foot, the
   // right foot stepping, the free left hand goes from hanging in front of the
   // table's edge, below its top, to resting over the top. Its joints'
   // interpolation sweeps the forearm through the edge; the planned path,
   // with the body on the witnesses' interpolation at its progress, clears it.
-  const Scenario& sc = chairScenario();
-  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
-  ASSERT_EQ(plan.stances.size(), 2u);
-  const Configuration& q0 = plan.stances[0].configuration;
-  const Configuration& q1 = plan.stances[1].configuration;
-  const CollisionModel collisions(sc.robot, sc.scene);
-  Kinematics kin(sc.robot);
-  const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_palm"));
+  ArmOverEdge f;
+  const Scenario& sc = f.sc;
+  const CollisionModel& collisions = f.collisions;
+  Kinematics& kin = f.kin;
+  const int root = f.root;
+  ASSERT_EQ(f.plan.stances.size(), 2u);
+  const Configuration& q0 = f.plan.stances[0].configuration;
+  const Configuration& q1 = f.plan.stances[1].configuration;
   const std::vector<int> joints = sc.robot->jointsMovedBy(root);
   ASSERT_EQ(joints.size(), 7u);  // LARM_JOINT0..6
   EXPECT_EQ(sc.robot->joints()[joints.front()].name, "LARM_JOINT0");
@@ -360,14 +373,14 @@ TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEach
 // clear in a narrow passage): two waypoints, the witnesses' values, even with
 // no budget for OMPL.
 TEST(LimbPathPlanner, AClearStraightPathIsTakenWithoutSearching) {
-  const Scenario& sc = chairScenario();
-  const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
-  const Configuration& q0 = plan.stances[0].configuration;  // the hand hanging in front of the table
+  ArmOverEdge f;
+  const Scenario& sc = f.sc;
+  const CollisionModel& collisions = f.collisions;
+  Kinematics& kin = f.kin;
+  const int root = f.root;
+  const Configuration& q0 = f.plan.stances[0].configuration;  // the hand hanging in front of the table
   Configuration q1 = q0;
-  const int root = sc.robot->spotLimbRootJoint(sc.robot->spotIndex("l_palm"));
   for (int j : sc.robot->jointsMovedBy(root)) q1.joints[j] += 0.03;
-  const CollisionModel collisions(sc.robot, sc.scene);
-  Kinematics kin(sc.robot);
   ASSERT_GT(limbSweepClearance(collisions, kin, root, q0, q1, 0.05), 0.012);
   LimbPathPlanOptions none;
   none.max_checks = 1;
