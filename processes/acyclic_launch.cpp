@@ -76,15 +76,22 @@ struct Listener {
                  m.stage.c_str(), m.elapsed_s, static_cast<long>(m.nodes_generated),
                  static_cast<long>(m.posture_calls), m.best_potential, m.message.c_str());
   }
+  // A refusal because the service is busy with this very request answers a
+  // second copy of the work (sent again when it looked lost), not the work:
+  // the first copy's answer is still to come.
+  bool busyWithOurs(const std::string& reason) const {
+    const std::string ours = "refused: busy with request " + std::to_string(request_id) + " ";
+    return reason.compare(0, ours.size(), ours) == 0;
+  }
   void onPlan(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     plan_t m;
     if (!proc::decode(rb, channel, m, status)) return;
-    if (m.request_id == request_id) plan = std::move(m);
+    if (m.request_id == request_id && !busyWithOurs(m.reason)) plan = std::move(m);
   }
   void onTrajectory(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     trajectory_t m;
     if (!proc::decode(rb, channel, m, status)) return;
-    if (m.request_id == request_id) trajectory = std::move(m);
+    if (m.request_id == request_id && !busyWithOurs(m.reason)) trajectory = std::move(m);
   }
   void onBridge(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     hrp2_bridge_status_t m;
@@ -263,8 +270,13 @@ int main(int argc, char** argv) {
         request_sent = false;
         continue;
       }
-      if (ear.plan && ear.plan->status == plan_t::OK && !no_interpolate && !ear.trajectory && !trajectory_written &&
-          ear.idle_since_work["acyclic-interpolator"] >= kIdleReportsMeanLost && resent < kMaxResends) {
+      // Only once the plan has been handed on (plan_sent_on, below, restarts
+      // the count): the interpolator reported idle all through the planning,
+      // and a plan that had just arrived was sent again at once, refused as a
+      // second copy ("busy with request N") and the run failed on it.
+      if (plan_sent_on && ear.plan->status == plan_t::OK && !no_interpolate && !ear.trajectory &&
+          !trajectory_written && ear.idle_since_work["acyclic-interpolator"] >= kIdleReportsMeanLost &&
+          resent < kMaxResends) {
         say("acyclic-interpolator is idle and no trajectory came: the plan or the trajectory was lost on the way; "
             "sending the plan again");
         ++resent;
