@@ -1,12 +1,13 @@
 // acyclic-planner: plans a scenario's contacts.
 //   File mode (--in SCENARIO --out PLAN): writes acyclic.plan/1. Progress on
 //   stderr on a terminal, nothing when not. Exit: 0 solved, 1 not solved
-//   (reason printed), 2 bad input.
+//   (reason printed) or a refused plan not written (--keep-refused), 2 bad input.
 //   LCM mode (--lcm): serves ACYCLIC_REQUEST, answers ACYCLIC_PLAN, reports on
 //   ACYCLIC_PROGRESS and ACYCLIC_STATUS, obeys ACYCLIC_CANCEL (planner_service).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <unistd.h>
 
 #include "processes/command_line.h"
@@ -15,6 +16,7 @@
 #include "planner/plan/guide.h"
 #include "planner/search/planner_parameters.h"
 #include "processes/lcm_process.h"
+#include "planner/search/refused_plans.h"
 #include "processes/planner_service.h"
 
 int main(int argc, char** argv) {
@@ -61,6 +63,12 @@ int main(int argc, char** argv) {
       "built with the interpolator)");
   app.add_flag("--no-verify-transitions", no_verify, "no verification of transitions, whatever the scenario says")
       ->excludes(verify_flag);
+  std::string keep_refused;
+  app.add_option("--keep-refused", keep_refused,
+                 "file mode: write each plan the verification refuses to DIR/refused_N.plan.json and its failing "
+                 "stances A..B to DIR/refused_N_stances_A-B.plan.json (give that to acyclic-interpolator --no-filter "
+                 "for the whole reason); DIR is created")
+      ->type_name("DIR");
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
@@ -70,8 +78,8 @@ int main(int argc, char** argv) {
 
   acyclic::proc::installSignalHandlers();
   if (lcm_mode) {
-    if (!in.empty() || !out.empty()) {
-      std::fprintf(stderr, "acyclic-planner: --lcm and --in/--out exclude each other\n");
+    if (!in.empty() || !out.empty() || !keep_refused.empty()) {
+      std::fprintf(stderr, "acyclic-planner: --lcm and --in/--out/--keep-refused exclude each other\n");
       return 2;
     }
     return acyclic::servePlanner(url, o);
@@ -88,7 +96,18 @@ int main(int argc, char** argv) {
                    "(acyclic-guide writes one) or write them in the scenario\n", in.c_str());
       return 2;
     }
-    const acyclic::PlannerParameters p = o.apply(sc, -1);
+    acyclic::PlannerParameters p = o.apply(sc, -1);
+    if (!keep_refused.empty()) {
+      // Made before the search, so that a bad path is said now, not after it.
+      std::error_code ec;
+      std::filesystem::create_directories(keep_refused, ec);
+      if (ec || !std::filesystem::is_directory(keep_refused)) {
+        std::fprintf(stderr, "acyclic-planner: --keep-refused %s: cannot make that directory%s%s\n",
+                     keep_refused.c_str(), ec ? ": " : "", ec ? ec.message().c_str() : "");
+        return 2;
+      }
+      p.keep_refused_plans = true;
+    }
     acyclic::ContactPlanner planner(sc, p);
     const bool tty = !quiet && isatty(STDERR_FILENO);
     auto progress = [&](const acyclic::PlanningStats& s) {
@@ -112,13 +131,26 @@ int main(int argc, char** argv) {
                   "%.2f s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds);
     for (std::size_t i = 0; i < r.refusals.size(); ++i)
       std::printf("acyclic-planner: plan %zu refused at %s\n", i + 1, r.refusals[i].c_str());
-    if (!r.solved()) {
+    if (r.solved()) {
+      acyclic::writePlan(r.plan, sc, out);
+      std::printf("acyclic-planner: %zu stances written to %s\n", r.plan.stances.size(), out.c_str());
+    } else {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
-      return 1;
     }
-    acyclic::writePlan(r.plan, sc, out);
-    std::printf("acyclic-planner: %zu stances written to %s\n", r.plan.stances.size(), out.c_str());
-    return 0;
+    // After the plan: a refused plan that cannot be written costs the answer nothing.
+    bool kept_all = true;
+    if (!keep_refused.empty()) {
+      try {
+        const std::vector<std::string> kept = acyclic::writeRefusedPlans(r, sc, keep_refused);
+        for (std::size_t i = 0; i + 1 < kept.size(); i += 2)
+          std::printf("acyclic-planner: refused plan %zu written to %s, its failing stances to %s\n", i / 2 + 1,
+                      kept[i].c_str(), kept[i + 1].c_str());
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "acyclic-planner: --keep-refused: %s\n", e.what());
+        kept_all = false;
+      }
+    }
+    return r.solved() && kept_all ? 0 : 1;
   } catch (const acyclic::FormatError& e) {
     std::fprintf(stderr, "acyclic-planner: %s\n", e.what());
     return 2;

@@ -57,3 +57,26 @@ TEST(AcyclicPlanner, ContradictoryFlagsAndABadKeyAreBadInput) {
   EXPECT_NE(bad.output.find("verify_transitions"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/p.json"));
 }
+
+// --keep-refused DIR: made before the search (a path that cannot be a
+// directory is bad input, said at once), nothing in it when no plan is
+// refused; not with --lcm. What it writes: ContactPlanner.APlanWhoseTransition...
+TEST(AcyclicPlanner, KeepRefusedMakesItsDirectoryFirstAndRefusesAPathThatCannotBeOne) {
+  acyclic::test::TempDir dir;
+  const std::string s = sourcePath("models/scenarios/step_forward.yaml");
+  const std::string kept = dir.path() + "/refused/here";
+  const auto ok = plan(s, dir.path() + "/p.json", "--keep-refused " + kept);
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  EXPECT_TRUE(std::filesystem::is_directory(kept));
+  EXPECT_TRUE(std::filesystem::is_empty(kept));  // step_forward's first plan is not refused
+  EXPECT_EQ(ok.output.find("refused plan"), std::string::npos) << ok.output;
+
+  const std::string file = dir.write("a_file", "not a directory\n");
+  const auto bad = plan(s, dir.path() + "/q.json", "--keep-refused " + file + "/sub");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--keep-refused " + file + "/sub"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/q.json"));  // said before any search
+
+  const auto lcm = runProcess(binaryPath("processes/acyclic-planner") + " --lcm --keep-refused " + kept);
+  EXPECT_EQ(lcm.status, 2) << lcm.output;
+}

@@ -6,6 +6,7 @@
 
 #include "planner/check/plan_check.h"
 #include "planner/common/format_error.h"
+#include "planner/search/refused_plans.h"
 #include "planner/search/planner_parameters.h"
 #include "planner/search/swing_check.h"
 #include "test_support.h"
@@ -410,6 +411,34 @@ TEST(ContactPlanner, APlanWhoseTransitionTheVerifierRefusesIsDroppedAndTheSearch
   }
   for (const auto& st : r.plan.stances) EXPECT_FALSE(same(st.configuration, refused));
   EXPECT_GT(r.stats.nodes_generated, plain.stats.nodes_generated);
+  EXPECT_TRUE(r.refused_plans.empty());  // kept only when asked
+  // Kept when asked (acyclic-planner --keep-refused): each plan as the
+  // verifier saw it, written whole and as its failing piece, which reads
+  // back as the two stances of the refused transition.
+  seen.clear();
+  PlannerParameters keep = p;
+  keep.keep_refused_plans = true;
+  const PlanningResult k = ContactPlanner(sc, keep).plan();
+  ASSERT_TRUE(k.solved());
+  ASSERT_EQ(k.refused_plans.size(), k.refusals.size());
+  ASSERT_FALSE(k.refused_plans.empty());
+  const RefusedPlan& first = k.refused_plans.front();
+  EXPECT_EQ(first.plan.stances.size(), seen.front().stances.size());
+  EXPECT_EQ(first.reason, "refused by the test");
+  EXPECT_EQ(first.failed_to, first.failed_from + 1);
+  EXPECT_TRUE(same(first.plan.stances[static_cast<std::size_t>(first.failed_to)].configuration, refused));
+  test::TempDir dir;
+  const std::vector<std::string> files = writeRefusedPlans(k, sc, dir.path());
+  ASSERT_EQ(files.size(), 2 * k.refused_plans.size());
+  EXPECT_EQ(readPlan(files[0], sc).stances.size(), first.plan.stances.size());
+  const Plan piece = readPlan(files[1], sc);
+  ASSERT_EQ(piece.stances.size(), 2u);
+  EXPECT_NE(files[1].find("_stances_" + std::to_string(first.failed_from) + "-" + std::to_string(first.failed_to)),
+            std::string::npos) << files[1];
+  EXPECT_TRUE(same(piece.stances[1].configuration, refused));
+  EXPECT_NEAR((piece.stances[0].configuration.base_position -
+               first.plan.stances[static_cast<std::size_t>(first.failed_from)].configuration.base_position).norm(),
+              0.0, 1e-9);
   // The same search again: the same plan (the verifier's verdicts are a function of the plan).
   seen.clear();
   const PlanningResult again = ContactPlanner(sc, p).plan();
@@ -475,6 +504,8 @@ TEST(ContactPlanner, ARefusedTransitionIntoASettledStanceGetsItsNextWitnessFirst
   EXPECT_EQ(r.stats.nodes_generated, plain.stats.nodes_generated);  // nothing dropped, nothing searched anew
   ASSERT_EQ(r.plan.stances.size(), plain.plan.stances.size());
   EXPECT_NE(r.plan.stances[2].configuration.joints, first.joints);
-  for (std::size_t k = 0; k < r.plan.stances.size(); ++k)
-    if (k != 2) EXPECT_EQ(r.plan.stances[k].configuration.joints, plain.plan.stances[k].configuration.joints) << k;
+  for (std::size_t k = 0; k < r.plan.stances.size(); ++k) {
+    if (k == 2) continue;
+    EXPECT_EQ(r.plan.stances[k].configuration.joints, plain.plan.stances[k].configuration.joints) << k;
+  }
 }

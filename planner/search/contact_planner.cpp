@@ -892,6 +892,7 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
         ++I.stats.plans_refused;
         out.refusals.push_back("stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
                                ": " + v.reason.substr(0, 300));
+        if (I.p.keep_refused_plans) out.refused_plans.push_back({plan, v.failed_from, v.failed_to, v.reason});
         const auto to = static_cast<std::size_t>(v.failed_to);
         const int owner = I.stance_owner.at(to);
         // A transition into a settled stance (between a removal and an

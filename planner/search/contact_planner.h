@@ -90,6 +90,10 @@ struct PlannerParameters {
   // verify_transitions without a verifier: the planner refuses to start.
   bool verify_transitions = false;
   PlanVerifier verify_plan;
+  // Each plan the verifier refuses is kept whole in the result
+  // (PlanningResult::refused_plans), to reproduce its failing transition
+  // with the interpolator (acyclic-planner --keep-refused).
+  bool keep_refused_plans = false;
   double failure_memory_distance = 0.05;  // m
   double failure_memory_angle = 0.35;     // rad
   PostureGeneratorOptions posture;     // max_iterations bounds each call deterministically
@@ -114,6 +118,14 @@ struct PlanningStats {
   bool verifying = false;  // reported while the verifier runs
 };
 
+// A plan the verifier refused, as the search found it, and its first
+// transition that cannot be made (stance indices in it).
+struct RefusedPlan {
+  Plan plan;
+  int failed_from = -1, failed_to = -1;
+  std::string reason;  // the verifier's, whole
+};
+
 struct PlanningResult {
   enum class Status { Solved, NoSolution, NodeBudget, PostureBudget, TimeLimit, Cancelled, InvalidInput };
   Status status = Status::InvalidInput;
@@ -123,6 +135,8 @@ struct PlanningResult {
   // Each plan the verifier refused (verify_transitions), in order: its first
   // failing transition, "stances A -> B: " and the reason's first 300 characters.
   std::vector<std::string> refusals;
+  // The refused plans themselves, in the same order, with keep_refused_plans.
+  std::vector<RefusedPlan> refused_plans;
   bool solved() const { return status == Status::Solved; }
 };
 
