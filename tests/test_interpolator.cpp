@@ -318,7 +318,8 @@ namespace {
 // The chair plan's free left arm going over the table's edge
 // (tests/data/chair_ompl_arm_over_edge.plan.json), with what a limb planner
 // needs there: the collision model, a Kinematics and the arm's root joint.
-struct ArmOverEdge {
+class ArmOverEdge : public ::testing::Test {
+ protected:
   const Scenario& sc = chairScenario();
   const Plan plan = readPlan(test::sourcePath("tests/data/chair_ompl_arm_over_edge.plan.json"), sc);
   const CollisionModel collisions{sc.robot, sc.scene};
@@ -327,20 +328,15 @@ struct ArmOverEdge {
 };
 }  // namespace
 
-TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEachTime) {
+TEST_F(ArmOverEdge, TheLimbPlannerTakesTheArmOverTheEdgeWithTheBodysProgressTheSameEachTime) {
   // From a plan of the chair with its OMPL guide: on the left foot, the
   // right foot stepping, the free left hand goes from hanging in front of the
   // table's edge, below its top, to resting over the top. Its joints'
   // interpolation sweeps the forearm through the edge; the planned path,
   // with the body on the witnesses' interpolation at its progress, clears it.
-  ArmOverEdge f;
-  const Scenario& sc = f.sc;
-  const CollisionModel& collisions = f.collisions;
-  Kinematics& kin = f.kin;
-  const int root = f.root;
-  ASSERT_EQ(f.plan.stances.size(), 2u);
-  const Configuration& q0 = f.plan.stances[0].configuration;
-  const Configuration& q1 = f.plan.stances[1].configuration;
+  ASSERT_EQ(plan.stances.size(), 2u);
+  const Configuration& q0 = plan.stances[0].configuration;
+  const Configuration& q1 = plan.stances[1].configuration;
   const std::vector<int> joints = sc.robot->jointsMovedBy(root);
   ASSERT_EQ(joints.size(), 7u);  // LARM_JOINT0..6
   EXPECT_EQ(sc.robot->joints()[joints.front()].name, "LARM_JOINT0");
@@ -372,13 +368,8 @@ TEST(LimbPathPlanner, PlansTheArmOverTheTableEdgeWithTheBodysProgressTheSameEach
 // search (RRTConnect grows toward random samples and missed such a path 3 mm
 // clear in a narrow passage): two waypoints, the witnesses' values, even with
 // no budget for OMPL.
-TEST(LimbPathPlanner, AClearStraightPathIsTakenWithoutSearching) {
-  ArmOverEdge f;
-  const Scenario& sc = f.sc;
-  const CollisionModel& collisions = f.collisions;
-  Kinematics& kin = f.kin;
-  const int root = f.root;
-  const Configuration& q0 = f.plan.stances[0].configuration;  // the hand hanging in front of the table
+TEST_F(ArmOverEdge, AClearStraightLimbPathIsTakenWithoutSearching) {
+  const Configuration& q0 = plan.stances[0].configuration;  // the hand hanging in front of the table
   Configuration q1 = q0;
   for (int j : sc.robot->jointsMovedBy(root)) q1.joints[j] += 0.03;
   ASSERT_GT(limbSweepClearance(collisions, kin, root, q0, q1, 0.05), 0.012);
