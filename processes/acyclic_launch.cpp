@@ -79,10 +79,7 @@ struct Listener {
   // A refusal because the service is busy with this very request answers a
   // second copy of the work (sent again when it looked lost), not the work:
   // the first copy's answer is still to come.
-  bool busyWithOurs(const std::string& reason) const {
-    const std::string ours = "refused: busy with request " + std::to_string(request_id) + " ";
-    return reason.compare(0, ours.size(), ours) == 0;
-  }
+  bool busyWithOurs(const std::string& reason) const { return proc::isBusyWith(reason, request_id); }
   void onPlan(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     plan_t m;
     if (!proc::decode(rb, channel, m, status)) return;

@@ -15,8 +15,8 @@
 #include "planner/posture/heap_tuning.h"
 #include "planner/plan/guide.h"
 #include "planner/search/planner_parameters.h"
-#include "processes/lcm_process.h"
 #include "planner/search/refused_plans.h"
+#include "processes/lcm_process.h"
 #include "processes/planner_service.h"
 
 int main(int argc, char** argv) {

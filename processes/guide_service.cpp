@@ -63,7 +63,7 @@ class GuideService : public proc::Service {
       guide_t m{};
       m.request_id = req.request_id;
       m.status = guide_t::ERROR;
-      m.reason = "refused: busy with request " + std::to_string(worker_.current()) + " (one request at a time)";
+      m.reason = proc::busyRefusal(worker_.current(), "request");
       status_.error(req.request_id, m.reason);
       answer(m);
       return;

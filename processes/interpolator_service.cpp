@@ -51,8 +51,7 @@ class InterpolatorService : public proc::Service {
     if (!proc::decode(rb, channel, m, status_)) return;
     if (m.status != plan_t::OK) return;  // no plan to interpolate: the planner has said why
     if (worker_.busy()) {
-      answerError(m.request_id, trajectory_t::ERROR,
-                  "refused: busy with request " + std::to_string(worker_.current()) + " (one plan at a time)");
+      answerError(m.request_id, trajectory_t::ERROR, proc::busyRefusal(worker_.current(), "plan"));
       return;
     }
     auto sc = std::make_shared<Scenario>();

@@ -38,6 +38,19 @@ std::int64_t nowMicros() {
       .count();
 }
 
+namespace {
+std::string busyPrefix(std::int64_t request) { return "refused: busy with request " + std::to_string(request) + " "; }
+}  // namespace
+
+std::string busyRefusal(std::int64_t current_request, const std::string& what) {
+  return busyPrefix(current_request) + "(one " + what + " at a time)";
+}
+
+bool isBusyWith(const std::string& reason, std::int64_t request_id) {
+  const std::string prefix = busyPrefix(request_id);
+  return reason.compare(0, prefix.size(), prefix) == 0;
+}
+
 void log(const std::string& process, const std::string& message) {
   const std::time_t t = std::time(nullptr);
   char stamp[32];

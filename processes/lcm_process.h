@@ -81,6 +81,13 @@ class StatusReporter {
 
 std::int64_t nowMicros();  // wall clock, for utime
 
+// A service busy with one request refuses another with this reason
+// ("refused: busy with request N (one W at a time)"); isBusyWith tells a
+// client that such a refusal names its own request: it answers a second
+// copy of that work, whose first copy is still being done.
+std::string busyRefusal(std::int64_t current_request, const std::string& what);
+bool isBusyWith(const std::string& reason, std::int64_t request_id);
+
 // Decodes a raw LCM message (the one decode path of every subscription): a
 // message that does not decode is counted and reported (status error naming
 // the channel and the reason, and a log line) and false returned, so a

@@ -117,9 +117,7 @@ class PlannerService : public proc::Service {
     if (!proc::decode(rb, channel, req, status_)) return;
     if (worker_.busy() || waiting_) {
       refuse(req, plan_t::ERROR,
-             "refused: busy with request " +
-                 std::to_string(worker_.busy() ? worker_.current() : waiting_->req.request_id) +
-                 " (one request at a time)");
+             proc::busyRefusal(worker_.busy() ? worker_.current() : waiting_->req.request_id, "request"));
       return;
     }
     // "<= 0: the scenario's" must not swallow a NaN, nor inf buy an endless search.

@@ -6,6 +6,7 @@
 
 #include "planner/common/format_error.h"
 #include "processes/lcm_convert.h"
+#include "processes/lcm_process.h"
 #include "test_support.h"
 
 using namespace acyclic;
@@ -205,4 +206,15 @@ TEST(LcmConvert, Hrp2MessagesThereAndBack) {
   EXPECT_EQ(bm.commands_sent, 300);
   EXPECT_EQ(bm.safety_events, 2);
   EXPECT_EQ(bm.reason, "done");
+}
+
+// A service's refusal while busy names the request it is busy with; the
+// launcher takes it for an answer to a second copy of its own work only when
+// that request is its own (request 12 is not request 1).
+TEST(LcmProcess, ABusyRefusalIsRecognisedForTheRequestItNamesOnly) {
+  const std::string r = acyclic::proc::busyRefusal(12, "plan");
+  EXPECT_EQ(r, "refused: busy with request 12 (one plan at a time)");
+  EXPECT_TRUE(acyclic::proc::isBusyWith(r, 12));
+  EXPECT_FALSE(acyclic::proc::isBusyWith(r, 1));
+  EXPECT_FALSE(acyclic::proc::isBusyWith("no plan within 60 s", 12));
 }
