@@ -1,5 +1,6 @@
 #include "processes/hrp2_sim_service.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <functional>
@@ -14,6 +15,7 @@
 #include "hrp2_bridge/periodic_loop.h"
 #include "hrp2_bridge/sim/dynamics_simulation.h"
 #include "hrp2_bridge/trajectory_file.h"
+#include "planner/common/fmt.h"
 #include "processes/lcm_convert.h"
 #include "processes/lcm_process.h"
 
@@ -145,6 +147,10 @@ int serveSimulator(const SimServiceOptions& options) {
   bool announced_freeze = false, holding_missed = false;
   long refused_reported = 0;
   std::int64_t refused_reported_at = 0;
+  // The work of a period against the period (the dynamics' integration mostly):
+  // a simulator that does not keep up shows as stale state at the bridge.
+  std::int64_t worst_work_us = 0;
+  long over_period = 0, periods = 0;
   while (!proc::stopRequested() && !lcm_failed) {
     const std::int64_t now = loop.wait();
     if (options.duration > 0 && now - t0 >= options.duration * 1e6) break;
@@ -171,6 +177,10 @@ int serveSimulator(const SimServiceOptions& options) {
       }
     }
     if (msg) bus->publish(channels::kHrp2State, *msg);
+    const std::int64_t work_us = hrp2::monotonicMicros() - now;
+    worst_work_us = std::max(worst_work_us, work_us);
+    over_period += work_us > o.dt * 1e6;
+    ++periods;
     bool holding_now;
     long refused;
     {
@@ -196,6 +206,9 @@ int serveSimulator(const SimServiceOptions& options) {
   receiver.join();
   wrench_thread.join();
   status.stopping();
+  proc::log(kName, fmt("%.0f periods, %.0f skipped; the worst period's work took %.1f ms, ", periods, loop.skipped(),
+                       worst_work_us * 1e-3) +
+                       std::to_string(over_period) + " periods' work took longer than the period");
   proc::log(kName, "commands: " + std::to_string(sim->received()) + " received, " + std::to_string(sim->applied()) +
                        " applied, " + std::to_string(sim->dropped()) + " dropped, " + std::to_string(sim->rejected()) +
                        " rejected, " + std::to_string(bad_messages) + " of the wrong size, " +
