@@ -87,6 +87,7 @@ TEST(GuideAuthor, SitDownEndsSeatedOnTheThighsOverTheFeetAndIsPlannedWithIt) {
   const Scenario base = Scenario::load(test::sourcePath("models/scenarios/sit_down.yaml"));
   GuideResult r;
   ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(base, r));
+  EXPECT_FALSE(r.approach) << "in front of the seat already: the straight blend sits down";
   const Configuration& end = r.guide.key_postures.back();
   Kinematics kin(base.robot);
   kin.setConfiguration(end);
@@ -339,10 +340,65 @@ TEST(GuideAuthor, SittingDownAtATableEndsOnTheSeatedPostureOverTheSeat) {
   // Over the seat (x in [-0.18, 0.16], y in [-0.21, 0.21]), facing the table.
   EXPECT_NEAR(end.base_position.y(), 0.0, 0.21);
   EXPECT_LT(end.base_position.x(), 0.16);
-  // Without the seated posture the author has no goal posture: the start
-  // stance carried toward the seat cannot sit on it.
-  GuideOptions none;
-  none.seated_posture = "no such posture";
-  const GuideResult without = authorGuide(sc, none);
+  // The start stance carried toward the seat's nearest point cannot sit on
+  // it (the table is in the way), nor carried in front of it (support_attempts
+  // stops before those): the seated posture put over the seat does it.
+  // Without it too, the author has no goal posture.
+  GuideOptions near_only;
+  // The placements around each allowed surface's nearest point: 1 on the
+  // floor (under the start), 7 toward the seat, 7 toward the table top.
+  near_only.support_attempts = 15;
+  const GuideResult seated_only = authorGuide(sc, near_only);
+  ASSERT_TRUE(seated_only.success()) << seated_only.reason;
+  EXPECT_LT(seated_only.guide.key_postures.back().base_position.x(), 0.16);
+  near_only.seated_posture = "no such posture";
+  const GuideResult without = authorGuide(sc, near_only);
   EXPECT_EQ(without.status, GuideResult::Status::NoGoalPosture) << without.reason;
+}
+
+// Sitting down at a table from beside it (models/scenarios/sit_at_table.yaml):
+// the straight blend from standing beside the chair into the seated goal
+// posture cuts over the seat's corner, so the guide stands in front of the
+// seat first (the approach posture: soles on the floor in front of the seat,
+// within its width, accepted by the check), then sits; the planner follows
+// it to the seat. Without the approach posture (before it was made) no plan
+// came within 3,000 nodes.
+TEST(GuideAuthor, SittingDownAtATableFromBesideItStandsInFrontOfTheSeatFirstAndIsPlanned) {
+  Scenario sc = Scenario::load(test::sourcePath("models/scenarios/sit_at_table.yaml"));
+  ASSERT_TRUE(sc.key_postures.empty());
+  GuideResult g;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, g));
+  ASSERT_TRUE(g.approach);
+  const double standing = sc.robot->posture("half_sitting").base_position.z();
+  const Configuration* approach = nullptr;  // the last standing key posture
+  for (const auto& q : g.guide.key_postures)
+    if (q.base_position.z() > standing - 0.03) approach = &q;
+  ASSERT_NE(approach, nullptr);
+  ASSERT_NE(approach, &g.guide.key_postures.front());
+  std::vector<ContactSpec> feet(2);
+  Kinematics kin(sc.robot);
+  kin.setConfiguration(*approach);
+  for (int k = 0; k < 2; ++k) {
+    feet[k].spot = sc.robot->spotIndex(k == 0 ? "r_sole" : "l_sole");
+    feet[k].surface = sc.scene->surfaceIndex("floor");
+    const Eigen::Vector3d p = kin.spotPose(feet[k].spot).translation();
+    EXPECT_GT(p.x(), 0.16) << "in front of the seat's edge";
+    EXPECT_LT(std::abs(p.y()), 0.21) << "within the seat's width";
+  }
+  placeOnSurfaces(sc, kin, feet);
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checker.checkPosture(*approach, feet).valid());
+  EXPECT_LT(g.guide.key_postures.back().base_position.z(), 0.40);  // the seated goal posture
+
+  sc.key_postures = g.guide.key_postures;
+  PlannerParameters p = plannerParameters(sc);
+  p.max_nodes = 2000;  // solved in 1,119: a node budget, not the machine's speed, bounds a failing run
+  p.max_seconds = 600;
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_TRUE(checkPlan(r.plan, sc, checker).valid());
+  int on_seat = 0;
+  for (const auto& c : r.plan.stances.back().contacts)
+    on_seat += c.spec.supporting && sc.scene->surfaces()[c.spec.surface].name == "chair_seat";
+  EXPECT_EQ(on_seat, 2);
 }

@@ -204,7 +204,9 @@ bool addSupports(const Scenario& sc, PostureGenerator& pg, ValidityChecker& chec
 // contacts (a squat), then the supports added (addSupports: touching first,
 // the start's contacts holding the robot). Carried by distances around the surface's
 // nearest point (where a sitting robot's feet go: in front of the seat),
-// nearest that point first, at most `support_attempts` in all. Every
+// nearest that point first, then in front of the surface along the start's
+// heading (0 to 40 cm past its front edge, across it at its middle), at
+// most `support_attempts` in all. Every
 // support on one surface (both thighs on a seat, both knees on the floor).
 bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGenerator& pg, ValidityChecker& checker,
                            Kinematics& kin, Configuration& out) {
@@ -233,6 +235,22 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
       candidates.push_back({std::abs(d - best), d * dir, si});
       if (best <= 1e-9) break;  // on it: no direction to carry
     }
+    // Then in front of a level surface other than the start's, along the
+    // start's heading, the base over the surface's middle across it: where
+    // a robot that starts beside the seat (or at an angle to it) sits down
+    // from, with its back to the surface. The carried stance keeps its heading.
+    bool start_surface = false;
+    for (const auto& c : sc.start_stance) start_surface = start_surface || c.surface == si;
+    if (start_surface || surf.frame.linear().col(2).z() < kLevelSurface) continue;
+    const double yaw = yawOf(sc.start.base_orientation);
+    const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
+    const Eigen::Vector2d c_local = surf.polygon.centroid();
+    const Eigen::Vector2d centre = (surf.frame * Eigen::Vector3d(c_local.x(), c_local.y(), 0)).head<2>();
+    double front = 0;  // the surface's extent ahead of its middle along the heading
+    for (const auto& v : surf.polygon.vertices())
+      front = std::max(front, ((surf.frame * Eigen::Vector3d(v.x(), v.y(), 0)).head<2>() - centre).dot(heading));
+    for (double d = 0.0; d <= 0.4 + 1e-9; d += 0.05)
+      candidates.push_back({1.0 + d, centre + (front + d) * heading - from, si});
   }
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.order < b.order; });
@@ -435,25 +453,91 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
   return false;
 }
 
-}  // namespace
-
-GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::atomic<bool>* cancel) {
-  GuideResult out;
-  const double t0 = now();
-  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  Configuration goal;
-  if (!goalPosture(sc, o, goal, out.reason)) {
-    out.status = GuideResult::Status::NoGoalPosture;
-    return out;
+// A standing posture from which a goal resting on supports the start does
+// not have (sitting down) is entered: the robot's standing posture turned to
+// the goal's heading, its soles (the start's contacts that are not the
+// goal's supports) in line with where the goal posture has them, as far in
+// front of them along that heading as the start is (at most 0.3 m), then
+// nearer and farther; through the posture generator on those contacts and
+// the independent check. A person walks in front of the seat and then backs
+// onto it: a path blending standing into sitting on the way from beside the
+// seat is clear of the scene, but the planner's stances cannot follow it
+// (sit_at_table: no plan in 3,000 nodes). False when there is none or the
+// goal needs none: supports among the start's contacts, or the start within
+// 0.1 m of it (sit_down: the straight blend is planned in 81 nodes, walking
+// back to the seat's edge first in more than 300).
+bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configuration& goal, Configuration& out) {
+  const RobotModel& m = *sc.robot;
+  const GoalCondition& g = sc.goal;
+  if (g.supporting_spots.empty() || !m.postures().count(o.standing_posture)) return false;
+  std::vector<ContactSpec> feet;  // the start's contacts that are not the goal's supports
+  bool new_support = false;
+  for (int s : g.supporting_spots) {
+    bool in_start = false;
+    for (const auto& c : sc.start_stance) in_start = in_start || c.spot == s;
+    new_support = new_support || !in_start;
   }
-  out.goal_seconds = now() - t0;
+  for (const auto& c : sc.start_stance)
+    if (std::find(g.supporting_spots.begin(), g.supporting_spots.end(), c.spot) == g.supporting_spots.end())
+      feet.push_back(c);
+  if (!new_support || feet.empty()) return false;
+  Kinematics kin(sc.robot);
+  auto feetMiddle = [&](const Configuration& q) {
+    kin.setConfiguration(q);
+    Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+    for (const auto& c : feet) mid += kin.spotPose(c.spot).translation();
+    return Eigen::Vector3d(mid / static_cast<double>(feet.size()));
+  };
+  const Eigen::Vector3d goal_feet = feetMiddle(goal);
+  const double yaw = yawOf(goal.base_orientation);
+  Configuration standing = m.posture(o.standing_posture);
+  standing.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d standing_feet = feetMiddle(standing);
+  // The start's feet over their surfaces: the height to stand at.
+  const Eigen::Vector3d start_feet = feetMiddle(sc.start);
+  const Eigen::Vector3d heading(std::cos(yaw), std::sin(yaw), 0);
+  PostureGeneratorOptions po;
+  po.max_iterations = 200;
+  po.max_seconds = 2.0;
+  PostureGenerator pg(sc.robot, sc.scene, po);
+  ValidityChecker checker(sc.robot, sc.scene);
+  // As far in front as the start is (at most 0.3 m): from there the robot
+  // backs onto the seat as from sit_down's start; then nearer and farther.
+  const double along = std::clamp((start_feet - goal_feet).dot(heading), 0.0, 0.3);
+  for (double d : {0.0, -0.05, 0.05, -0.1, 0.1, -0.15, -0.2, -0.25, -0.3}) {
+    if (along + d < -1e-9) continue;
+    Configuration q = standing;
+    q.base_position += goal_feet - standing_feet + (along + d) * heading;
+    q.base_position.z() = standing.base_position.z() + start_feet.z() - standing_feet.z();
+    if ((q.base_position - sc.start.base_position).head<2>().norm() < 0.1) return false;  // in line already
+    kin.setConfiguration(q);
+    std::vector<ContactSpec> stance = feet;
+    if (!placeWhereHeld(sc, kin, stance)) continue;
+    PostureRequest r;
+    r.contacts = stance;
+    r.initial_guess = q;
+    r.cost = std::make_shared<ReferencePostureCost>(q, 0.01, 10.0, 1.0);
+    const PostureResult res = pg.solve(r);
+    if (!res.success() || !checker.checkPosture(res.configuration, stance).valid()) continue;
+    out = res.configuration;
+    return true;
+  }
+  return false;
+}
 
-  Lift lift{sc.start, goal, yawOf(sc.start.base_orientation), yawOf(goal.base_orientation)};
+// One leg of the rough trajectory: OMPL's RRTConnect in the reduced space
+// blending `from` into `to` within `budget` seconds, shortcut, its vertices
+// lifted to whole-body postures (the first `from`, the last `to` exactly).
+// False with out.status and out.reason set when there is no path.
+bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& from, const Configuration& to,
+             const std::string& what, double budget, const std::atomic<bool>* cancel,
+             GuideResult& out, std::vector<Configuration>& postures) {
+  Lift lift{from, to, yawOf(from.base_orientation), yawOf(to.base_orientation)};
   auto space = std::make_shared<ob::RealVectorStateSpace>(5);
   ob::RealVectorBounds b(5);
   for (int k = 0; k < 3; ++k) {
-    const double lo = std::min(sc.start.base_position[k], goal.base_position[k]);
-    const double hi = std::max(sc.start.base_position[k], goal.base_position[k]);
+    const double lo = std::min(from.base_position[k], to.base_position[k]);
+    const double hi = std::max(from.base_position[k], to.base_position[k]);
     const double margin = k == 2 ? 0.15 : 0.6;  // sideways room for detours; a little height
     b.setLow(k, lo - margin);
     b.setHigh(k, hi + margin);
@@ -472,22 +556,21 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   si->setStateValidityCheckingResolution(0.01);  // 1% of the space's extent per check along a motion
 
   ob::ScopedState<ob::RealVectorStateSpace> start(space), target(space);
-  const double sv[5] = {sc.start.base_position.x(), sc.start.base_position.y(), sc.start.base_position.z(),
-                        lift.yaw_start, 0.0};
-  const double gv[5] = {goal.base_position.x(), goal.base_position.y(), goal.base_position.z(), lift.yaw_goal, 1.0};
+  const double sv[5] = {from.base_position.x(), from.base_position.y(), from.base_position.z(), lift.yaw_start, 0.0};
+  const double gv[5] = {to.base_position.x(), to.base_position.y(), to.base_position.z(), lift.yaw_goal, 1.0};
   for (int k = 0; k < 5; ++k) start[k] = sv[k], target[k] = gv[k];
   if (!validity->isValid(start.get())) {
     out.status = GuideResult::Status::InvalidStart;
     out.reason = "the start posture penetrates the scene by more than " + std::to_string(o.penetration) + " m";
-    return out;
+    return false;
   }
   if (!validity->isValid(target.get())) {
     out.status = GuideResult::Status::NoGoalPosture;
-    out.reason = "the goal posture penetrates the scene";
-    return out;
+    out.reason = "the " + what + " penetrates the scene";
+    return false;
   }
   // The ceiling: the standing posture's base height over its soles, plus
-  // GuideOptions::ceiling_slack, when the start and the goal are both under it.
+  // GuideOptions::ceiling_slack, when both ends are under it.
   if (sc.robot->postures().count(o.standing_posture)) {
     Kinematics kin(sc.robot);
     const Configuration standing = sc.robot->posture(o.standing_posture);
@@ -510,41 +593,82 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   ss.setPlanner(planner);
   ss.setup();
   const double t1 = now();
-  const double budget = o.max_seconds;
   const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition([&] {
     return now() - t1 > budget || (cancel && cancel->load());
   }));
-  out.path_seconds = now() - t1;
+  out.path_seconds += now() - t1;
   if (cancel && cancel->load()) {
     out.status = GuideResult::Status::Cancelled;
     out.reason = "cancelled";
-    return out;
+    return false;
   }
   if (st != ob::PlannerStatus::EXACT_SOLUTION) {
     out.status = GuideResult::Status::NoPath;
-    out.reason = "OMPL (RRTConnect) found no path to the goal posture within " + std::to_string(budget) + " s";
-    return out;
+    out.reason = "OMPL (RRTConnect) found no path to the " + what + " within " + std::to_string(budget) + " s";
+    return false;
   }
   og::PathGeometric path = ss.getSolutionPath();
-  out.path_vertices = static_cast<int>(path.getStateCount());
+  out.path_vertices += static_cast<int>(path.getStateCount());
   SeededSimplifier simplifier(si, seed);
   simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
   simplifier.shortcutPath(path, static_cast<unsigned>(o.shortcut_steps));
   simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+  postures.clear();
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+    const double* v = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
+    postures.push_back(i == 0 ? from : (i + 1 == path.getStateCount() ? to : lift(v)));
+  }
+  return true;
+}
+
+}  // namespace
+
+GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::atomic<bool>* cancel) {
+  GuideResult out;
+  const double t0 = now();
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  Configuration goal;
+  if (!goalPosture(sc, o, goal, out.reason)) {
+    out.status = GuideResult::Status::NoGoalPosture;
+    return out;
+  }
+  // Legs: through the approach posture where the goal needs one. Where no
+  // path reaches it within half the budget (a chair 6 cm from its table:
+  // the posture stands there, but no blend of two standing postures gets
+  // between them), straight to the goal posture.
+  std::vector<std::vector<Configuration>> legs;
+  Configuration approach;
+  std::vector<Configuration> leg;
+  if (approachPosture(sc, o, goal, approach)) {
+    if (planLeg(sc, o, sc.start, approach, "approach posture", o.max_seconds / 2, cancel, out, leg)) {
+      legs.push_back(leg);
+      if (!planLeg(sc, o, approach, goal, "goal posture from the approach posture", o.max_seconds / 2, cancel,
+                   out, leg))
+        return out;
+      legs.push_back(leg);
+      out.approach = true;
+    }
+    else if (out.status == GuideResult::Status::Cancelled) return out;
+  }
+  out.goal_seconds = now() - t0 - out.path_seconds;  // the goal and approach postures
+  if (legs.empty()) {
+    if (!planLeg(sc, o, sc.start, goal, "goal posture", o.max_seconds, cancel, out, leg)) return out;
+    legs.push_back(leg);
+  }
 
   Guide& g = out.guide;
   g.source = "ompl";
   g.scenario = sc.path;
-  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
-    const double* s = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
-    Configuration q = i == 0 ? sc.start : (i + 1 == path.getStateCount() ? goal : lift(s));
-    // Consecutive key postures must differ in their base (the guide's base
-    // projection is one-to-one).
-    if (!g.key_postures.empty() &&
-        (q.base_position - g.key_postures.back().base_position).norm() < 0.01 &&
-        q.base_orientation.angularDistance(g.key_postures.back().base_orientation) < 0.02)
-      continue;
-    g.key_postures.push_back(q);
+  for (const auto& postures : legs) {
+    for (const Configuration& q : postures) {
+      // Consecutive key postures must differ in their base (the guide's base
+      // projection is one-to-one): a leg's first is the last one's end.
+      if (!g.key_postures.empty() &&
+          (q.base_position - g.key_postures.back().base_position).norm() < 0.01 &&
+          q.base_orientation.angularDistance(g.key_postures.back().base_orientation) < 0.02)
+        continue;
+      g.key_postures.push_back(q);
+    }
   }
   if (g.key_postures.size() < 2) {
     out.status = GuideResult::Status::NoPath;

@@ -42,7 +42,8 @@ struct GuideResult {
   Status status = Status::InvalidStart;
   std::string reason;
   Guide guide;                  // on success
-  int path_vertices = 0;        // before shortcutting
+  int path_vertices = 0;        // before shortcutting (every leg's)
+  bool approach = false;        // an approach posture before the goal posture (approachPosture)
   double goal_seconds = 0, path_seconds = 0;
   bool success() const { return status == Status::Success; }
 };
