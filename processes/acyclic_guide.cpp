@@ -23,7 +23,10 @@ int main(int argc, char** argv) {
       "then RRTConnect in (base position, heading, blend from the start posture to the goal posture) with\n"
       "FCL against the scene, the robot allowed to graze obstacles by --penetration and its base kept\n"
       "within its standing height (+3 cm) of the ground within a step of it; the path shortcut and lifted\n"
-      "to whole-body key postures.\n"
+      "to whole-body key postures. For a goal resting on spots the start lacks (sitting down) from a start\n"
+      "not in line with it, through an approach posture standing in front of it first. Where standing\n"
+      "postures find no path within half the budget (a low beam), again with a crouch coordinate (the\n"
+      "start stance lowered on its feet) in the space.\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
       "File mode: --in SCENARIO --out GUIDE; exit status 0 written, 1 no guide (reason printed), 2 bad input.\n"
       "LCM mode: --lcm answers every ACYCLIC_REQUEST whose scenario has no key postures with ACYCLIC_GUIDE\n"
@@ -43,7 +46,10 @@ int main(int argc, char** argv) {
   app.add_option("--penetration", o.penetration, "robot-scene penetration allowed along the guide, m")
       ->capture_default_str();
   app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
+  bool no_crouch = false;
+  app.add_flag("--no-crouch", no_crouch, "standing postures only: no second try with a crouch");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
+  o.crouch = !no_crouch;
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   proc::installSignalHandlers();
   if (lcm_mode) return serveGuide(url, o);

@@ -402,3 +402,39 @@ TEST(GuideAuthor, SittingDownAtATableFromBesideItStandsInFrontOfTheSeatFirstAndI
     on_seat += c.spec.supporting && sc.scene->surfaces()[c.spec.surface].name == "chair_seat";
   EXPECT_EQ(on_seat, 2);
 }
+
+// Ducking under a low beam (models/scenarios/duck_under_beam.yaml): no path
+// of standing postures passes under it, so the guide is planned again with
+// the crouch coordinate; its key posture under the beam is crouched, and the
+// planner walks under the beam on its feet, crouched, to a valid plan.
+TEST(GuideAuthor, ALowBeamIsPassedCrouchedAndPlanned) {
+  Scenario sc = Scenario::load(test::sourcePath("models/scenarios/duck_under_beam.yaml"));
+  ASSERT_TRUE(sc.key_postures.empty());
+  GuideOptions standing_only;
+  standing_only.crouch = false;
+  standing_only.max_seconds = 2;
+  const GuideResult refused = authorGuide(sc, standing_only);
+  EXPECT_EQ(refused.status, GuideResult::Status::NoPath) << refused.reason;
+  EXPECT_NE(refused.reason.find("crouch"), std::string::npos) << refused.reason;
+
+  GuideResult g;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, g));
+  EXPECT_TRUE(g.crouch);
+  const double standing = sc.start.base_position.z();
+  double lowest_under = standing;  // the base's lowest among key postures under the beam (x in [0.5, 1.0])
+  for (const auto& q : g.guide.key_postures)
+    if (q.base_position.x() > 0.5 && q.base_position.x() < 1.0) lowest_under = std::min(lowest_under, q.base_position.z());
+  EXPECT_LT(lowest_under, standing - 0.15);
+
+  sc.key_postures = g.guide.key_postures;
+  PlannerParameters p = plannerParameters(sc);
+  p.max_nodes = 1000;  // solved in 170: a node budget, not the machine's speed, bounds a failing run
+  p.max_seconds = 600;
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  ValidityChecker checker(sc.robot, sc.scene);
+  EXPECT_TRUE(checkPlan(r.plan, sc, checker).valid());
+  double lowest = standing;
+  for (const auto& st : r.plan.stances) lowest = std::min(lowest, st.configuration.base_position.z());
+  EXPECT_LT(lowest, standing - 0.15) << "walked under the beam crouched";
+}

@@ -12,6 +12,7 @@
 
 #include "planner/check/validity.h"
 #include "planner/collision/collision_model.h"
+#include "planner/common/fmt.h"
 #include "planner/common/geometry.h"
 #include "planner/guide/seeded_ompl.h"
 #include "planner/posture/posture_generator.h"
@@ -43,11 +44,14 @@ double yawOf(const Eigen::Quaterniond& q) {
   return std::atan2(R(1, 0), R(0, 0));
 }
 
-// The reduced space: (x, y, z, yaw, alpha). alpha blends the joints and the
-// base's tilt from the start posture (0) to the goal posture (1).
+// The reduced space: (x, y, z, yaw, alpha), and with a crouch a sixth
+// coordinate c. alpha blends the joints and the base's tilt from the start
+// posture (0) to the goal posture (1); c adds c times the crouch's joint
+// offsets (the start stance lowered on its feet, crouchOffsets).
 struct Lift {
   Configuration start, goal;
   double yaw_start = 0, yaw_goal = 0;
+  Eigen::VectorXd crouch;  // joint offsets; empty: no crouch coordinate
   Configuration operator()(const double* s) const {
     const double a = std::clamp(s[4], 0.0, 1.0);
     Configuration q;
@@ -57,6 +61,7 @@ struct Lift {
     q.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(s[3] - yaw_blend, Eigen::Vector3d::UnitZ())) * tilt;
     q.base_orientation.normalize();
     q.joints = (1 - a) * start.joints + a * goal.joints;
+    if (crouch.size()) q.joints += std::clamp(s[5], 0.0, 1.0) * crouch;
     return q;
   }
 };
@@ -525,27 +530,59 @@ bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configurat
   return false;
 }
 
+// A crouch: the start stance lowered on its own contacts (a squat on the
+// feet) by the posture generator, as deep as the independent check accepts
+// (the base 0.35 m down, then 0.30 ... 0.15); its joints' offsets from the
+// start posture and how far the base came down. False when none is valid.
+bool crouchOffsets(const Scenario& sc, Eigen::VectorXd& offsets, double& drop) {
+  PostureGeneratorOptions po;
+  po.max_iterations = 200;
+  po.max_seconds = 2.0;
+  PostureGenerator pg(sc.robot, sc.scene, po);
+  ValidityChecker checker(sc.robot, sc.scene);
+  for (double d : {0.35, 0.30, 0.25, 0.20, 0.15}) {
+    Configuration lowered = sc.start;
+    lowered.base_position.z() -= d;
+    PostureRequest r;
+    r.contacts = sc.start_stance;
+    r.initial_guess = sc.start;
+    r.cost = std::make_shared<ReferencePostureCost>(lowered, 0.01, 10.0, 1.0);
+    const PostureResult res = pg.solve(r);
+    if (!res.success() || !checker.checkPosture(res.configuration, sc.start_stance).valid()) continue;
+    drop = sc.start.base_position.z() - res.configuration.base_position.z();
+    if (drop < 0.1) continue;  // not a crouch
+    offsets = res.configuration.joints - sc.start.joints;
+    return true;
+  }
+  return false;
+}
+
 // One leg of the rough trajectory: OMPL's RRTConnect in the reduced space
 // blending `from` into `to` within `budget` seconds, shortcut, its vertices
 // lifted to whole-body postures (the first `from`, the last `to` exactly).
+// With `crouch` (joint offsets, and the base's drop with them), the space
+// has the crouch coordinate and the base may go that much lower.
 // False with out.status and out.reason set when there is no path.
 bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& from, const Configuration& to,
-             const std::string& what, double budget, const std::atomic<bool>* cancel,
-             GuideResult& out, std::vector<Configuration>& postures) {
-  Lift lift{from, to, yawOf(from.base_orientation), yawOf(to.base_orientation)};
-  auto space = std::make_shared<ob::RealVectorStateSpace>(5);
-  ob::RealVectorBounds b(5);
+             const std::string& what, double budget, const Eigen::VectorXd& crouch, double crouch_drop,
+             const std::atomic<bool>* cancel, GuideResult& out, std::vector<Configuration>& postures) {
+  Lift lift{from, to, yawOf(from.base_orientation), yawOf(to.base_orientation), crouch};
+  const unsigned dims = crouch.size() ? 6 : 5;
+  auto space = std::make_shared<ob::RealVectorStateSpace>(dims);
+  ob::RealVectorBounds b(dims);
   for (int k = 0; k < 3; ++k) {
     const double lo = std::min(from.base_position[k], to.base_position[k]);
     const double hi = std::max(from.base_position[k], to.base_position[k]);
     const double margin = k == 2 ? 0.15 : 0.6;  // sideways room for detours; a little height
-    b.setLow(k, lo - margin);
+    b.setLow(k, lo - margin - (k == 2 ? crouch_drop : 0.0));
     b.setHigh(k, hi + margin);
   }
   b.setLow(3, std::min(lift.yaw_start, lift.yaw_goal) - M_PI / 2);
   b.setHigh(3, std::max(lift.yaw_start, lift.yaw_goal) + M_PI / 2);
-  b.setLow(4, 0.0);
-  b.setHigh(4, 1.0);
+  for (unsigned k = 4; k < dims; ++k) {
+    b.setLow(k, 0.0);
+    b.setHigh(k, 1.0);
+  }
   space->setBounds(b);
   const unsigned seed = o.seed;
   space->setStateSamplerAllocator([seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
@@ -556,9 +593,9 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& fro
   si->setStateValidityCheckingResolution(0.01);  // 1% of the space's extent per check along a motion
 
   ob::ScopedState<ob::RealVectorStateSpace> start(space), target(space);
-  const double sv[5] = {from.base_position.x(), from.base_position.y(), from.base_position.z(), lift.yaw_start, 0.0};
-  const double gv[5] = {to.base_position.x(), to.base_position.y(), to.base_position.z(), lift.yaw_goal, 1.0};
-  for (int k = 0; k < 5; ++k) start[k] = sv[k], target[k] = gv[k];
+  const double sv[6] = {from.base_position.x(), from.base_position.y(), from.base_position.z(), lift.yaw_start, 0.0, 0.0};
+  const double gv[6] = {to.base_position.x(), to.base_position.y(), to.base_position.z(), lift.yaw_goal, 1.0, 0.0};
+  for (unsigned k = 0; k < dims; ++k) start[k] = sv[k], target[k] = gv[k];
   if (!validity->isValid(start.get())) {
     out.status = GuideResult::Status::InvalidStart;
     out.reason = "the start posture penetrates the scene by more than " + std::to_string(o.penetration) + " m";
@@ -604,7 +641,7 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& fro
   }
   if (st != ob::PlannerStatus::EXACT_SOLUTION) {
     out.status = GuideResult::Status::NoPath;
-    out.reason = "OMPL (RRTConnect) found no path to the " + what + " within " + std::to_string(budget) + " s";
+    out.reason = "OMPL (RRTConnect) found no path to the " + what + fmt(" within %.1f s", budget);
     return false;
   }
   og::PathGeometric path = ss.getSolutionPath();
@@ -640,9 +677,9 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   Configuration approach;
   std::vector<Configuration> leg;
   if (approachPosture(sc, o, goal, approach)) {
-    if (planLeg(sc, o, sc.start, approach, "approach posture", o.max_seconds / 2, cancel, out, leg)) {
+    if (planLeg(sc, o, sc.start, approach, "approach posture", o.max_seconds / 2, {}, 0, cancel, out, leg)) {
       legs.push_back(leg);
-      if (!planLeg(sc, o, approach, goal, "goal posture from the approach posture", o.max_seconds / 2, cancel,
+      if (!planLeg(sc, o, approach, goal, "goal posture from the approach posture", o.max_seconds / 2, {}, 0, cancel,
                    out, leg))
         return out;
       legs.push_back(leg);
@@ -651,9 +688,33 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     else if (out.status == GuideResult::Status::Cancelled) return out;
   }
   out.goal_seconds = now() - t0 - out.path_seconds;  // the goal and approach postures
+  // Straight to the goal posture; where no path comes within half the
+  // budget, with a crouch (under a low bar: the blend of two standing
+  // postures cannot lower the head).
   if (legs.empty()) {
-    if (!planLeg(sc, o, sc.start, goal, "goal posture", o.max_seconds, cancel, out, leg)) return out;
+    if (planLeg(sc, o, sc.start, goal, "goal posture", o.max_seconds / 2, {}, 0, cancel, out, leg))
+      legs.push_back(leg);
+    else if (out.status != GuideResult::Status::NoPath) return out;
+  }
+  if (legs.empty() && !o.crouch) {
+    out.reason += " (a crouch was not tried: switched off)";
+    return out;
+  }
+  if (legs.empty()) {
+    Eigen::VectorXd crouch;
+    double drop = 0;
+    const std::string standing_failure = out.reason;
+    if (!crouchOffsets(sc, crouch, drop)) {
+      out.reason = standing_failure + "; the start stance has no valid crouch to try";
+      return out;
+    }
+    if (!planLeg(sc, o, sc.start, goal, "goal posture", o.max_seconds / 2, crouch, drop, cancel, out, leg)) {
+      if (out.status == GuideResult::Status::NoPath)
+        out.reason = standing_failure + fmt(", nor with a crouch of %.2f m", drop);
+      return out;
+    }
     legs.push_back(leg);
+    out.crouch = true;
   }
 
   Guide& g = out.guide;

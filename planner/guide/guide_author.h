@@ -34,6 +34,9 @@ struct GuideOptions {
   // m: the path's base at most this much higher over the ground under it
   // than the standing posture's base over its soles (authorGuide).
   double ceiling_slack = 0.03;
+  // Where no path of standing postures reaches the goal within half of
+  // max_seconds, try again with a crouch coordinate (authorGuide).
+  bool crouch = true;
   unsigned seed = 1;
 };
 
@@ -44,6 +47,7 @@ struct GuideResult {
   Guide guide;                  // on success
   int path_vertices = 0;        // before shortcutting (every leg's)
   bool approach = false;        // an approach posture before the goal posture (approachPosture)
+  bool crouch = false;          // the path needed the crouch coordinate (crouchOffsets)
   double goal_seconds = 0, path_seconds = 0;
   bool success() const { return status == Status::Success; }
 };
