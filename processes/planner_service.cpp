@@ -87,10 +87,12 @@ class PlannerService : public proc::Service {
     proc::Service::tick();
     if (waiting_ && proc::nowMicros() - waiting_->since_us > kGuideTimeoutUs) {
       const request_t req = waiting_->req;
+      const std::string early = waiting_->early_guide;
       waiting_.reset();
       refuse(req, plan_t::NO_SOLUTION,
              "no ACYCLIC_GUIDE arrived within " + std::to_string(kGuideTimeoutUs / 1000000) +
-                 " s for a scenario without key postures (is acyclic-guide running?)");
+                 " s for a scenario without key postures (is acyclic-guide running?)" +
+                 (early.empty() ? "" : "; one with its id came before the request and was not used: " + early));
       status_.idle();
     }
   }
@@ -143,17 +145,41 @@ class PlannerService : public proc::Service {
     if (sc->key_postures.size() < 2 && params.guide_potential) {
       // No hand-written guide: the guide process authors one (ACYCLIC_GUIDE).
       status_.busy(req.request_id);
+      // A guide that came before its request is used only when it is a
+      // guide of this request's robot: another sender's message with the same
+      // id (a stale run, a fuzzer: CI once planned request 8 on a mangled
+      // guide of 2 joints) must not answer it. Otherwise wait for the guide
+      // process's own answer, keeping the early one's word for the timeout.
+      std::string early;
       const auto g = guides_.find(req.request_id);
       if (g != guides_.end()) {
-        useGuide(req, sc, params, g->second);
-      } else {
-        proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + sc->name +
-                                " has no key postures: waiting for its ACYCLIC_GUIDE");
-        waiting_ = Waiting{req, sc, params, proc::nowMicros()};
+        early = earlyGuideProblem(g->second, *sc);
+        if (early.empty()) {
+          useGuide(req, sc, params, g->second);
+          guides_.erase(req.request_id);
+          return;
+        }
+        guides_.erase(g);
+        status_.error(req.request_id, "an ACYCLIC_GUIDE with its id came before it and is not used: " + early);
       }
+      proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + sc->name +
+                              " has no key postures: waiting for its ACYCLIC_GUIDE");
+      waiting_ = Waiting{req, sc, params, proc::nowMicros(), early};
       return;
     }
     startPlanning(req, sc, params);
+  }
+
+  // Why a guide received before its request is not taken as its answer
+  // (empty: it is): not OK, or key postures that are not the scenario's robot's.
+  static std::string earlyGuideProblem(const guide_t& g, const Scenario& sc) {
+    if (g.status != guide_t::OK) return "status " + std::to_string(g.status) + ": " + g.reason;
+    try {
+      for (const auto& m : g.postures) convert::fromMessage(m, sc, "ACYCLIC_GUIDE (request " + std::to_string(g.request_id) + ")");
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return "";
   }
 
   void useGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params,
@@ -274,6 +300,7 @@ class PlannerService : public proc::Service {
     std::shared_ptr<Scenario> sc;
     PlannerParameters params;
     std::int64_t since_us;
+    std::string early_guide;  // why a guide with its id that came before it was not used
   };
   static constexpr std::int64_t kGuideTimeoutUs = 60'000'000;
   static constexpr double kMaxBudgetS = 7 * 24 * 3600.0;  // a week
