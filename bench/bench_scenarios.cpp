@@ -54,9 +54,11 @@ int main(int argc, char** argv) {
     Scenario sc = Scenario::load(path);
     double guide_seconds = 0;
     const bool guided = sc.key_postures.size() < 2;
+    std::string guide_kind;
     if (guided) {
       const GuideResult g = authorGuide(sc, GuideOptions());
       guide_seconds = g.goal_seconds + g.path_seconds;
+      guide_kind = std::string(g.approach ? ", through an approach posture" : "") + (g.crouch ? ", crouched" : "");
       if (!g.success()) {
         std::printf("%-14s %-16s %9.2f  the OMPL guide author: %s\n", sc.name.c_str(), "no guide", guide_seconds,
                     g.reason.c_str());
@@ -87,8 +89,8 @@ int main(int argc, char** argv) {
                 guide_seconds + r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures,
                 r.plan.stances.size(), verdict.c_str(), used.empty() ? "none" : used.c_str());
     if (guided)
-      std::printf("%-14s   guided by the OMPL author: %zu key postures in %.2f s\n", "", sc.key_postures.size(),
-                  guide_seconds);
+      std::printf("%-14s   guided by the OMPL author: %zu key postures in %.2f s%s\n", "", sc.key_postures.size(),
+                  guide_seconds, guide_kind.c_str());
     if (r.stats.plans_verified > 0)
       std::printf("%-14s   transitions verified: %ld plans, %ld refused, %ld transitions solved, %.2f s of the %.2f s\n",
                   "", r.stats.plans_verified, r.stats.plans_refused, r.stats.transitions_solved,

@@ -72,6 +72,8 @@ int main(int argc, char** argv) {
                 "(goal posture %.2f s, OMPL %.2f s), written to %s\n",
                 sc.name.c_str(), g.key_postures.size(), r.path_vertices, g.seconds, r.goal_seconds, r.path_seconds,
                 out.c_str());
+    if (r.approach) std::printf("acyclic-guide: through an approach posture standing in front of the goal\n");
+    if (r.crouch) std::printf("acyclic-guide: crouched: no path of standing postures\n");
     return 0;
   } catch (const FormatError& e) {
     std::fprintf(stderr, "acyclic-guide: %s\n", e.what());
