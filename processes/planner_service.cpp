@@ -170,15 +170,31 @@ class PlannerService : public proc::Service {
     startPlanning(req, sc, params);
   }
 
+  // A guide's key postures for the scenario; throws FormatError naming the field.
+  static std::vector<Configuration> guidePostures(const guide_t& g, const Scenario& sc) {
+    std::vector<Configuration> out;
+    for (const auto& m : g.postures)
+      out.push_back(convert::fromMessage(m, sc, "ACYCLIC_GUIDE (request " + std::to_string(g.request_id) + ")"));
+    return out;
+  }
   // Why a guide received before its request is not taken as its answer
-  // (empty: it is): not OK, or key postures that are not the scenario's robot's.
+  // (empty: it is): not OK, key postures that are not the scenario's robot's,
+  // or that do not start at the scenario's start (the guide author's first
+  // key posture is the start exactly).
   static std::string earlyGuideProblem(const guide_t& g, const Scenario& sc) {
     if (g.status != guide_t::OK) return "status " + std::to_string(g.status) + ": " + g.reason;
+    std::vector<Configuration> q;
     try {
-      for (const auto& m : g.postures) convert::fromMessage(m, sc, "ACYCLIC_GUIDE (request " + std::to_string(g.request_id) + ")");
+      q = guidePostures(g, sc);
     } catch (const std::exception& e) {
       return e.what();
     }
+    if (q.size() < 2) return "fewer than 2 key postures";
+    const Configuration& a = q.front();
+    if ((a.base_position - sc.start.base_position).norm() > 1e-9 ||
+        a.base_orientation.angularDistance(sc.start.base_orientation) > 1e-9 ||
+        (a.joints - sc.start.joints).norm() > 1e-9)
+      return "its first key posture is not the scenario's start";
     return "";
   }
 
@@ -190,9 +206,8 @@ class PlannerService : public proc::Service {
       return;
     }
     try {
-      for (const auto& m : g.postures)
-        sc->key_postures.push_back(convert::fromMessage(m, *sc, "ACYCLIC_GUIDE (request " +
-                                                                    std::to_string(req.request_id) + ")"));
+      const std::vector<Configuration> q = guidePostures(g, *sc);
+      sc->key_postures.insert(sc->key_postures.end(), q.begin(), q.end());
     } catch (const std::exception& e) {
       refuse(req, plan_t::INVALID_INPUT, std::string("the guide cannot be read: ") + e.what());
       status_.idle();

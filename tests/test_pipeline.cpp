@@ -25,6 +25,7 @@
 #include "acyclic/request_t.hpp"
 #include "acyclic/trajectory_t.hpp"
 #include "lcmtypes/channels.hpp"
+#include "planner/scene/scenario.h"
 #include "processes/lcm_process.h"
 #include "processes/supervisor.h"
 #include "fuzz_support.h"
@@ -509,6 +510,19 @@ TEST(Pipeline, AForeignGuideThatComesBeforeItsRequestIsNotUsed) {
   const process_status_t* set_aside = c.error("acyclic-planner", "came before it");
   ASSERT_NE(set_aside, nullptr);
   EXPECT_NE(set_aside->reason.find("num_joints"), std::string::npos) << set_aside->reason;
+
+  // The robot's joints, but not from this scenario's start (a stale run's).
+  foreign.request_id = 10;
+  q.num_joints = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml")).robot->numJoints();
+  q.joints.assign(q.num_joints, 0.0);
+  foreign.postures = {q, q};
+  c.bus.publish(channels::kGuide, foreign);
+  c.waitFor([] { return false; }, 0.5);
+  req.request_id = 10;
+  c.bus.publish(channels::kRequest, req);
+  ASSERT_TRUE(c.waitFor([&] { return c.plans.count(10) > 0; }, 90));
+  EXPECT_EQ(c.plans[10].status, +plan_t::OK) << c.plans[10].reason;
+  EXPECT_NE(c.error("acyclic-planner", "not the scenario's start"), nullptr);
 }
 
 TEST(Pipeline, BadRequestFieldsAndAPoisonedCancelKillNothingAndAStoppedPlannerAnswersNoUnfinishedWork) {

@@ -100,6 +100,7 @@ class RelaxedValidity : public ob::StateValidityChecker {
       : ob::StateValidityChecker(si), sc_(sc), lift_(lift), kin_(sc.robot), collision_(sc.robot, sc.scene),
         penetration_(penetration) {}
   void setCeiling(double above_ground) { ceiling_ = above_ground; }
+  const long& checks() const { return checks_; }  // states checked so far
   // The base's height above the ground within a step of it (the highest
   // under its point and the corners and edge middles of a square 2 kStep
   // wide around it: a foot put up there lets the base rise); nullopt: no ground.
@@ -115,6 +116,7 @@ class RelaxedValidity : public ob::StateValidityChecker {
     return s[2] - *g;
   }
   bool isValid(const ob::State* state) const override {
+    ++checks_;
     const double* s = state->as<ob::RealVectorStateSpace::StateType>()->values;
     if (ceiling_) {
       const auto h = heightAboveGround(s);
@@ -136,6 +138,7 @@ class RelaxedValidity : public ob::StateValidityChecker {
   CollisionModel collision_;
   double penetration_;
   std::optional<double> ceiling_;
+  mutable long checks_ = 0;
 };
 
 // Each contact placed where kin holds its spot, supporting; false if one
@@ -469,8 +472,9 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
 // seat is clear of the scene, but the planner's stances cannot follow it
 // (sit_at_table: no plan in 3,000 nodes). False when there is none or the
 // goal needs none: supports among the start's contacts, or the start within
-// 0.1 m of it (sit_down: the straight blend is planned in 81 nodes, walking
-// back to the seat's edge first in more than 300).
+// 0.1 m of it and facing within 20 degrees of the same way (sit_down: the
+// straight blend is planned in 81 nodes, walking back to the seat's edge
+// first in more than 300).
 bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configuration& goal, Configuration& out) {
   const RobotModel& m = *sc.robot;
   const GoalCondition& g = sc.goal;
@@ -509,12 +513,18 @@ bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configurat
   // As far in front as the start is (at most 0.3 m): from there the robot
   // backs onto the seat as from sit_down's start; then nearer and farther.
   const double along = std::clamp((start_feet - goal_feet).dot(heading), 0.0, 0.3);
-  for (double d : {0.0, -0.05, 0.05, -0.1, 0.1, -0.15, -0.2, -0.25, -0.3}) {
-    if (along + d < -1e-9) continue;
+  auto placed = [&](double d) {
     Configuration q = standing;
     q.base_position += goal_feet - standing_feet + (along + d) * heading;
     q.base_position.z() = standing.base_position.z() + start_feet.z() - standing_feet.z();
-    if ((q.base_position - sc.start.base_position).head<2>().norm() < 0.1) return false;  // in line already
+    return q;
+  };
+  // In line already: the start stands where the first placement would, facing the same way.
+  const double turn = std::abs(std::remainder(yawOf(sc.start.base_orientation) - yaw, 2 * M_PI));
+  if ((placed(0).base_position - sc.start.base_position).head<2>().norm() < 0.1 && turn < 0.35) return false;
+  for (double d : {0.0, -0.05, 0.05, -0.1, 0.1, -0.15, -0.2, -0.25, -0.3}) {
+    if (along + d < -1e-9) continue;
+    const Configuration q = placed(d);
     kin.setConfiguration(q);
     std::vector<ContactSpec> stance = feet;
     if (!placeWhereHeld(sc, kin, stance)) continue;
@@ -561,11 +571,23 @@ bool crouchOffsets(const Scenario& sc, Eigen::VectorXd& offsets, double& drop) {
 // blending `from` into `to` within `budget` seconds, shortcut, its vertices
 // lifted to whole-body postures (the first `from`, the last `to` exactly).
 // With `crouch` (joint offsets, and the base's drop with them), the space
-// has the crouch coordinate and the base may go that much lower.
+// has the crouch coordinate and the base may go that much lower. With
+// `max_checks` > 0 the search also stops after that many state checks: a try
+// whose failure leads to another (approach, then standing, then crouched)
+// ends on a count, not on the machine's speed, so that the same scenario and
+// seed give the same guide.
 // False with out.status and out.reason set when there is no path.
-bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& from, const Configuration& to,
-             const std::string& what, double budget, const Eigen::VectorXd& crouch, double crouch_drop,
-             const std::atomic<bool>* cancel, GuideResult& out, std::vector<Configuration>& postures) {
+struct LegEnds {
+  const Configuration& from;
+  const Configuration& to;
+  std::string from_what, to_what;  // "start posture", "approach posture", "goal posture"
+};
+bool planLeg(const Scenario& sc, const GuideOptions& o, const LegEnds& ends, double budget, long max_checks,
+             const Eigen::VectorXd& crouch, double crouch_drop, const std::atomic<bool>* cancel, GuideResult& out,
+             std::vector<Configuration>& postures) {
+  const Configuration& from = ends.from;
+  const Configuration& to = ends.to;
+  const std::string& what = ends.to_what;
   Lift lift{from, to, yawOf(from.base_orientation), yawOf(to.base_orientation), crouch};
   const unsigned dims = crouch.size() ? 6 : 5;
   auto space = std::make_shared<ob::RealVectorStateSpace>(dims);
@@ -598,7 +620,7 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& fro
   for (unsigned k = 0; k < dims; ++k) start[k] = sv[k], target[k] = gv[k];
   if (!validity->isValid(start.get())) {
     out.status = GuideResult::Status::InvalidStart;
-    out.reason = "the start posture penetrates the scene by more than " + std::to_string(o.penetration) + " m";
+    out.reason = "the " + ends.from_what + fmt(" penetrates the scene by more than %.3f m", o.penetration);
     return false;
   }
   if (!validity->isValid(target.get())) {
@@ -631,7 +653,7 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& fro
   ss.setup();
   const double t1 = now();
   const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition([&] {
-    return now() - t1 > budget || (cancel && cancel->load());
+    return now() - t1 > budget || (max_checks > 0 && validity->checks() >= max_checks) || (cancel && cancel->load());
   }));
   out.path_seconds += now() - t1;
   if (cancel && cancel->load()) {
@@ -641,7 +663,9 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const Configuration& fro
   }
   if (st != ob::PlannerStatus::EXACT_SOLUTION) {
     out.status = GuideResult::Status::NoPath;
-    out.reason = "OMPL (RRTConnect) found no path to the " + what + fmt(" within %.1f s", budget);
+    out.reason = "OMPL (RRTConnect) found no path to the " + what +
+                 (max_checks > 0 && validity->checks() >= max_checks ? fmt(" within %.0f state checks", max_checks)
+                                                                      : fmt(" within %.1f s", budget));
     return false;
   }
   og::PathGeometric path = ss.getSolutionPath();
@@ -669,30 +693,36 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     out.status = GuideResult::Status::NoGoalPosture;
     return out;
   }
-  // Legs: through the approach posture where the goal needs one. Where no
-  // path reaches it within half the budget (a chair 6 cm from its table:
-  // the posture stands there, but no blend of two standing postures gets
-  // between them), straight to the goal posture.
+  out.goal_seconds = now() - t0;  // the goal posture (and at the end, every posture made)
+  // One budget for every search (GuideOptions::max_seconds); the tries
+  // whose failure leads to another stop on a count of state checks first.
+  const double deadline = now() + o.max_seconds;
+  auto remaining = [&] { return std::max(0.0, deadline - now()); };
+  const LegEnds straight{sc.start, goal, "start posture", "goal posture"};
   std::vector<std::vector<Configuration>> legs;
-  Configuration approach;
   std::vector<Configuration> leg;
+  int approach_index = -1;
+  // Through the approach posture where the goal needs one. Where no path
+  // reaches it (a chair 6 cm from its table: the posture stands there, but
+  // no blend of two standing postures gets between them), or none goes on
+  // from it, straight to the goal posture.
+  Configuration approach;
   if (approachPosture(sc, o, goal, approach)) {
-    if (planLeg(sc, o, sc.start, approach, "approach posture", o.max_seconds / 2, {}, 0, cancel, out, leg)) {
-      legs.push_back(leg);
-      if (!planLeg(sc, o, approach, goal, "goal posture from the approach posture", o.max_seconds / 2, {}, 0, cancel,
-                   out, leg))
-        return out;
-      legs.push_back(leg);
+    const LegEnds first{sc.start, approach, "start posture", "approach posture"};
+    const LegEnds second{approach, goal, "approach posture", "goal posture from the approach posture"};
+    std::vector<Configuration> to_approach;
+    if (planLeg(sc, o, first, remaining(), o.fallback_checks, {}, 0, cancel, out, to_approach) &&
+        planLeg(sc, o, second, remaining(), o.fallback_checks, {}, 0, cancel, out, leg)) {
+      approach_index = static_cast<int>(to_approach.size()) - 1;
+      legs = {to_approach, leg};
       out.approach = true;
     }
-    else if (out.status == GuideResult::Status::Cancelled) return out;
+    if (out.status == GuideResult::Status::Cancelled) return out;
   }
-  out.goal_seconds = now() - t0 - out.path_seconds;  // the goal and approach postures
-  // Straight to the goal posture; where no path comes within half the
-  // budget, with a crouch (under a low bar: the blend of two standing
-  // postures cannot lower the head).
+  // Straight to the goal posture; where no path comes, with a crouch (under
+  // a low beam: a blend of two standing postures cannot lower the head).
   if (legs.empty()) {
-    if (planLeg(sc, o, sc.start, goal, "goal posture", o.max_seconds / 2, {}, 0, cancel, out, leg))
+    if (planLeg(sc, o, straight, remaining(), o.crouch ? o.fallback_checks : 0, {}, 0, cancel, out, leg))
       legs.push_back(leg);
     else if (out.status != GuideResult::Status::NoPath) return out;
   }
@@ -708,7 +738,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
       out.reason = standing_failure + "; the start stance has no valid crouch to try";
       return out;
     }
-    if (!planLeg(sc, o, sc.start, goal, "goal posture", o.max_seconds / 2, crouch, drop, cancel, out, leg)) {
+    if (!planLeg(sc, o, straight, remaining(), 0, crouch, drop, cancel, out, leg)) {
       if (out.status == GuideResult::Status::NoPath)
         out.reason = standing_failure + fmt(", nor with a crouch of %.2f m", drop);
       return out;
@@ -730,6 +760,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
         continue;
       g.key_postures.push_back(q);
     }
+    if (&postures == &legs.front() && approach_index >= 0) out.approach_index = static_cast<int>(g.key_postures.size()) - 1;
   }
   if (g.key_postures.size() < 2) {
     out.status = GuideResult::Status::NoPath;
@@ -737,7 +768,9 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     return out;
   }
   g.seconds = now() - t0;
+  out.goal_seconds = g.seconds - out.path_seconds;  // the goal, approach and crouch postures
   out.status = GuideResult::Status::Success;
+  out.reason.clear();  // an approach or standing leg that failed on the way said why; the guide was made
   return out;
 }
 

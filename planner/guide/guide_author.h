@@ -20,7 +20,11 @@ namespace acyclic {
 
 struct GuideOptions {
   double penetration = 0.03;    // m: robot-environment penetration allowed along the rough trajectory
-  double max_seconds = 10;      // wall time for OMPL's search
+  double max_seconds = 10;      // wall time for OMPL's searches, all of them
+  // State checks at most for a search whose failure leads to another (to the
+  // approach posture, standing where a crouch may follow): those decisions
+  // are the same under any load.
+  long fallback_checks = 50000;
   double range = 0.2;           // RRTConnect's range, in the reduced space's metric
   int shortcut_steps = 300;     // PathSimplifier attempts (counts, not time: deterministic)
   double goal_margin = 0.05;    // m: how far past the goal's bound the goal posture stands
@@ -47,6 +51,7 @@ struct GuideResult {
   Guide guide;                  // on success
   int path_vertices = 0;        // before shortcutting (every leg's)
   bool approach = false;        // an approach posture before the goal posture (approachPosture)
+  int approach_index = -1;      // its index in guide.key_postures
   bool crouch = false;          // the path needed the crouch coordinate (crouchOffsets)
   double goal_seconds = 0, path_seconds = 0;
   bool success() const { return status == Status::Success; }
