@@ -149,10 +149,11 @@ int serveSimulator(const SimServiceOptions& options) {
   std::int64_t refused_reported_at = 0;
   // The work of a period against the period (the dynamics' integration mostly):
   // a simulator that does not keep up shows as stale state at the bridge.
-  std::int64_t worst_work_us = 0;
+  std::int64_t worst_work_us = 0, worst_late_us = 0;  // and the wake-ups' lateness (a stall while asleep)
   long over_period = 0, periods = 0;
   while (!proc::stopRequested() && !lcm_failed) {
     const std::int64_t now = loop.wait();
+    worst_late_us = std::max(worst_late_us, now - loop.deadline());
     if (options.duration > 0 && now - t0 >= options.duration * 1e6) break;
     std::optional<hrp2_state_t> msg;
     {
@@ -208,7 +209,8 @@ int serveSimulator(const SimServiceOptions& options) {
   status.stopping();
   proc::log(kName, fmt("%.0f periods, %.0f skipped; the worst period's work took %.1f ms, ", periods, loop.skipped(),
                        worst_work_us * 1e-3) +
-                       std::to_string(over_period) + " periods' work took longer than the period");
+                       std::to_string(over_period) + fmt(" periods' work took longer than the period; the latest wake-up "
+                                                         "came %.1f ms after its deadline", worst_late_us * 1e-3));
   proc::log(kName, "commands: " + std::to_string(sim->received()) + " received, " + std::to_string(sim->applied()) +
                        " applied, " + std::to_string(sim->dropped()) + " dropped, " + std::to_string(sim->rejected()) +
                        " rejected, " + std::to_string(bad_messages) + " of the wrong size, " +
