@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/PathSimplifier.h>
@@ -154,6 +155,59 @@ bool placeWhereHeld(const Scenario& sc, const Kinematics& kin, std::vector<Conta
   return on;
 }
 
+// The guide author's posture tools, made once per guide: the posture
+// generator (200 iterations, 2 s a call), the independent check, kinematics.
+PostureGeneratorOptions guidePostureOptions() {
+  PostureGeneratorOptions po;
+  po.max_iterations = 200;
+  po.max_seconds = 2.0;
+  return po;
+}
+struct PostureTools {
+  explicit PostureTools(const Scenario& sc)
+      : kin(sc.robot), pg(sc.robot, sc.scene, guidePostureOptions()), checker(sc.robot, sc.scene) {}
+  Kinematics kin;
+  PostureGenerator pg;
+  ValidityChecker checker;
+};
+
+// A witness of `contacts` from `guess`, drawn toward `reference` (its joints
+// weighed 0.01 of its base's place): a posture near a chosen one. nullopt
+// when the posture generator finds none.
+std::optional<Configuration> witnessNear(PostureGenerator& pg, const std::vector<ContactSpec>& contacts,
+                                         const Configuration& guess, const Configuration& reference) {
+  PostureRequest r;
+  r.contacts = contacts;
+  r.initial_guess = guess;
+  r.cost = std::make_shared<ReferencePostureCost>(reference, 0.01, 10.0, 1.0);
+  const PostureResult res = pg.solve(r);
+  if (!res.success()) return std::nullopt;
+  return res.configuration;
+}
+
+// The start's contacts that are not among the goal's supports (the soles of
+// a robot that sits down).
+std::vector<ContactSpec> startContactsBesideSupports(const Scenario& sc) {
+  const std::vector<int>& supports = sc.goal.supporting_spots;
+  std::vector<ContactSpec> out;
+  for (const auto& c : sc.start_stance)
+    if (std::find(supports.begin(), supports.end(), c.spot) == supports.end()) out.push_back(c);
+  return out;
+}
+
+// A level surface no start contact is on (a seat to sit on).
+bool levelSurfaceOffStart(const Scenario& sc, int si) {
+  for (const auto& c : sc.start_stance)
+    if (c.surface == si) return false;
+  return sc.scene->surfaces()[si].frame.linear().col(2).z() >= kLevelSurface;
+}
+
+// A surface's polygon's centroid, in the world.
+Eigen::Vector3d surfaceMiddle(const Surface& surf) {
+  const Eigen::Vector2d c = surf.polygon.centroid();
+  return surf.frame * Eigen::Vector3d(c.x(), c.y(), 0);
+}
+
 // A goal posture: a witness of `contacts` (placed where `q` puts their spots)
 // from the guess q, accepted by the independent check, in the goal (the
 // link's bound, and the supports the goal names).
@@ -247,13 +301,10 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
     // start's heading, the base over the surface's middle across it: where
     // a robot that starts beside the seat (or at an angle to it) sits down
     // from, with its back to the surface. The carried stance keeps its heading.
-    bool start_surface = false;
-    for (const auto& c : sc.start_stance) start_surface = start_surface || c.surface == si;
-    if (start_surface || surf.frame.linear().col(2).z() < kLevelSurface) continue;
+    if (!levelSurfaceOffStart(sc, si)) continue;
     const double yaw = yawOf(sc.start.base_orientation);
     const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
-    const Eigen::Vector2d c_local = surf.polygon.centroid();
-    const Eigen::Vector2d centre = (surf.frame * Eigen::Vector3d(c_local.x(), c_local.y(), 0)).head<2>();
+    const Eigen::Vector2d centre = surfaceMiddle(surf).head<2>();
     double front = 0;  // the surface's extent ahead of its middle along the heading
     for (const auto& v : surf.polygon.vertices())
       front = std::max(front, ((surf.frame * Eigen::Vector3d(v.x(), v.y(), 0)).head<2>() - centre).dot(heading));
@@ -272,13 +323,8 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
     // joints free to fold (a squat over the feet before the seat is touched).
     Configuration lowered = q;
     lowered.base_position.z() += target - link_z;
-    PostureRequest r;
-    r.contacts = stance;
-    r.initial_guess = q;
-    r.cost = std::make_shared<ReferencePostureCost>(lowered, 0.01, 10.0, 1.0);
-    const PostureResult res = pg.solve(r);
-    if (!res.success()) continue;
-    if (addSupports(sc, pg, checker, kin, stance, candidates[i].surface, res.configuration, out)) return true;
+    const auto squat = witnessNear(pg, stance, q, lowered);
+    if (squat && addSupports(sc, pg, checker, kin, stance, candidates[i].surface, *squat, out)) return true;
   }
   return false;
 }
@@ -305,17 +351,10 @@ bool goalPostureSeated(const Scenario& sc, const GuideOptions& o, PostureGenerat
   for (int s : g.supporting_spots) supports += kin.spotPose(s).translation();
   supports /= static_cast<double>(g.supporting_spots.size());
   const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
-  std::vector<ContactSpec> others;  // the start's contacts that are not the goal's supports
-  for (const auto& c : sc.start_stance)
-    if (std::find(g.supporting_spots.begin(), g.supporting_spots.end(), c.spot) == g.supporting_spots.end())
-      others.push_back(c);
+  const std::vector<ContactSpec> others = startContactsBesideSupports(sc);
   for (int si : sc.allowed_surfaces) {
-    const Surface& surf = sc.scene->surfaces()[si];
-    bool start_surface = false;
-    for (const auto& c : sc.start_stance) start_surface = start_surface || c.surface == si;
-    if (start_surface || surf.frame.linear().col(2).z() < kLevelSurface) continue;
-    const Eigen::Vector2d centroid = surf.polygon.centroid();
-    const Eigen::Vector3d middle = surf.frame * Eigen::Vector3d(centroid.x(), centroid.y(), 0);
+    if (!levelSurfaceOffStart(sc, si)) continue;
+    const Eigen::Vector3d middle = surfaceMiddle(sc.scene->surfaces()[si]);
     for (double d : {0.0, -0.05, 0.05, -0.1, 0.1}) {
       Configuration q = seated;
       q.base_position += middle - supports;
@@ -329,13 +368,9 @@ bool goalPostureSeated(const Scenario& sc, const GuideOptions& o, PostureGenerat
         stance.push_back(c);
       }
       if (!placeWhereHeld(sc, kin, stance)) continue;
-      PostureRequest r;
-      r.contacts = stance;
-      r.initial_guess = q;
-      r.cost = std::make_shared<ReferencePostureCost>(q, 0.01, 10.0, 1.0);
-      const PostureResult res = pg.solve(r);
-      if (!res.success()) continue;
-      Configuration at = res.configuration;
+      const auto resting = witnessNear(pg, stance, q, q);
+      if (!resting) continue;
+      Configuration at = *resting;
       bool added = true;
       for (const auto& other : others) {
         const Surface& on = sc.scene->surfaces()[other.surface];
@@ -374,7 +409,7 @@ bool goalPostureSeated(const Scenario& sc, const GuideOptions& o, PostureGenerat
 // Each through the posture generator and the independent check, the free
 // horizontal coordinate tried around the start's, nearest first.
 
-bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, std::string& why) {
+bool goalPosture(const Scenario& sc, const GuideOptions& o, PostureTools& t, Configuration& out, std::string& why) {
   const RobotModel& m = *sc.robot;
   if (!m.postures().count(o.standing_posture)) {
     why = "the robot has no posture named '" + o.standing_posture + "'";
@@ -390,12 +425,9 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
   }
   const GoalCondition& g = sc.goal;
   const double yaw = yawOf(sc.start.base_orientation);
-  Kinematics kin(sc.robot);
-  PostureGeneratorOptions po;
-  po.max_iterations = 200;
-  po.max_seconds = 2.0;
-  PostureGenerator pg(sc.robot, sc.scene, po);
-  ValidityChecker checker(sc.robot, sc.scene);
+  Kinematics& kin = t.kin;
+  PostureGenerator& pg = t.pg;
+  ValidityChecker& checker = t.checker;
   if (g.axis == 2) {  // a height: nothing to carry along; only a posture on the goal's supports
     if (goalPostureOnSupports(sc, o, pg, checker, kin, out)) return true;
     if (goalPostureSeated(sc, o, pg, checker, kin, out)) return true;
@@ -475,22 +507,16 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, Configuration& out, 
 // 0.1 m of it and facing within 20 degrees of the same way (sit_down: the
 // straight blend is planned in 81 nodes, walking back to the seat's edge
 // first in more than 300).
-bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configuration& goal, Configuration& out) {
+bool approachPosture(const Scenario& sc, const GuideOptions& o, PostureTools& t, const Configuration& goal,
+                     Configuration& out) {
   const RobotModel& m = *sc.robot;
   const GoalCondition& g = sc.goal;
   if (g.supporting_spots.empty() || !m.postures().count(o.standing_posture)) return false;
-  std::vector<ContactSpec> feet;  // the start's contacts that are not the goal's supports
-  bool new_support = false;
-  for (int s : g.supporting_spots) {
-    bool in_start = false;
-    for (const auto& c : sc.start_stance) in_start = in_start || c.spot == s;
-    new_support = new_support || !in_start;
-  }
-  for (const auto& c : sc.start_stance)
-    if (std::find(g.supporting_spots.begin(), g.supporting_spots.end(), c.spot) == g.supporting_spots.end())
-      feet.push_back(c);
+  const std::vector<ContactSpec> feet = startContactsBesideSupports(sc);
+  // Some goal support is not a start contact: fewer start contacts are supports than the goal names.
+  const bool new_support = sc.start_stance.size() - feet.size() < g.supporting_spots.size();
   if (!new_support || feet.empty()) return false;
-  Kinematics kin(sc.robot);
+  Kinematics& kin = t.kin;
   auto feetMiddle = [&](const Configuration& q) {
     kin.setConfiguration(q);
     Eigen::Vector3d mid = Eigen::Vector3d::Zero();
@@ -505,11 +531,6 @@ bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configurat
   // The start's feet over their surfaces: the height to stand at.
   const Eigen::Vector3d start_feet = feetMiddle(sc.start);
   const Eigen::Vector3d heading(std::cos(yaw), std::sin(yaw), 0);
-  PostureGeneratorOptions po;
-  po.max_iterations = 200;
-  po.max_seconds = 2.0;
-  PostureGenerator pg(sc.robot, sc.scene, po);
-  ValidityChecker checker(sc.robot, sc.scene);
   // As far in front as the start is (at most 0.3 m): from there the robot
   // backs onto the seat as from sit_down's start; then nearer and farther.
   const double along = std::clamp((start_feet - goal_feet).dot(heading), 0.0, 0.3);
@@ -528,13 +549,9 @@ bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configurat
     kin.setConfiguration(q);
     std::vector<ContactSpec> stance = feet;
     if (!placeWhereHeld(sc, kin, stance)) continue;
-    PostureRequest r;
-    r.contacts = stance;
-    r.initial_guess = q;
-    r.cost = std::make_shared<ReferencePostureCost>(q, 0.01, 10.0, 1.0);
-    const PostureResult res = pg.solve(r);
-    if (!res.success() || !checker.checkPosture(res.configuration, stance).valid()) continue;
-    out = res.configuration;
+    const auto standing_there = witnessNear(t.pg, stance, q, q);
+    if (!standing_there || !t.checker.checkPosture(*standing_there, stance).valid()) continue;
+    out = *standing_there;
     return true;
   }
   return false;
@@ -544,24 +561,15 @@ bool approachPosture(const Scenario& sc, const GuideOptions& o, const Configurat
 // feet) by the posture generator, as deep as the independent check accepts
 // (the base 0.35 m down, then 0.30 ... 0.15); its joints' offsets from the
 // start posture and how far the base came down. False when none is valid.
-bool crouchOffsets(const Scenario& sc, Eigen::VectorXd& offsets, double& drop) {
-  PostureGeneratorOptions po;
-  po.max_iterations = 200;
-  po.max_seconds = 2.0;
-  PostureGenerator pg(sc.robot, sc.scene, po);
-  ValidityChecker checker(sc.robot, sc.scene);
+bool crouchOffsets(const Scenario& sc, PostureTools& t, Eigen::VectorXd& offsets, double& drop) {
   for (double d : {0.35, 0.30, 0.25, 0.20, 0.15}) {
     Configuration lowered = sc.start;
     lowered.base_position.z() -= d;
-    PostureRequest r;
-    r.contacts = sc.start_stance;
-    r.initial_guess = sc.start;
-    r.cost = std::make_shared<ReferencePostureCost>(lowered, 0.01, 10.0, 1.0);
-    const PostureResult res = pg.solve(r);
-    if (!res.success() || !checker.checkPosture(res.configuration, sc.start_stance).valid()) continue;
-    drop = sc.start.base_position.z() - res.configuration.base_position.z();
+    const auto squat = witnessNear(t.pg, sc.start_stance, sc.start, lowered);
+    if (!squat || !t.checker.checkPosture(*squat, sc.start_stance).valid()) continue;
+    drop = sc.start.base_position.z() - squat->base_position.z();
     if (drop < 0.1) continue;  // not a crouch
-    offsets = res.configuration.joints - sc.start.joints;
+    offsets = squat->joints - sc.start.joints;
     return true;
   }
   return false;
@@ -689,7 +697,8 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   const double t0 = now();
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   Configuration goal;
-  if (!goalPosture(sc, o, goal, out.reason)) {
+  PostureTools tools(sc);
+  if (!goalPosture(sc, o, tools, goal, out.reason)) {
     out.status = GuideResult::Status::NoGoalPosture;
     return out;
   }
@@ -707,7 +716,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   // no blend of two standing postures gets between them), or none goes on
   // from it, straight to the goal posture.
   Configuration approach;
-  if (approachPosture(sc, o, goal, approach)) {
+  if (approachPosture(sc, o, tools, goal, approach)) {
     const LegEnds first{sc.start, approach, "start posture", "approach posture"};
     const LegEnds second{approach, goal, "approach posture", "goal posture from the approach posture"};
     std::vector<Configuration> to_approach;
@@ -734,7 +743,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     Eigen::VectorXd crouch;
     double drop = 0;
     const std::string standing_failure = out.reason;
-    if (!crouchOffsets(sc, crouch, drop)) {
+    if (!crouchOffsets(sc, tools, crouch, drop)) {
       out.reason = standing_failure + "; the start stance has no valid crouch to try";
       return out;
     }
