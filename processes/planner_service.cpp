@@ -153,13 +153,14 @@ class PlannerService : public proc::Service {
       std::string early;
       const auto g = guides_.find(req.request_id);
       if (g != guides_.end()) {
-        early = earlyGuideProblem(g->second, *sc);
+        const guide_t guide = std::move(g->second);
+        guides_.erase(g);
+        std::vector<Configuration> postures;
+        early = earlyGuideProblem(guide, *sc, postures);
         if (early.empty()) {
-          useGuide(req, sc, params, g->second);
-          guides_.erase(req.request_id);
+          planOnGuide(req, sc, params, guide, postures);
           return;
         }
-        guides_.erase(g);
         status_.error(req.request_id, "an ACYCLIC_GUIDE with its id came before it and is not used: " + early);
       }
       proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + sc->name +
@@ -178,12 +179,11 @@ class PlannerService : public proc::Service {
     return out;
   }
   // Why a guide received before its request is not taken as its answer
-  // (empty: it is): not OK, key postures that are not the scenario's robot's,
-  // or that do not start at the scenario's start (the guide author's first
-  // key posture is the start exactly).
-  static std::string earlyGuideProblem(const guide_t& g, const Scenario& sc) {
+  // (empty: it is, its key postures in `q`): not OK, key postures that are
+  // not the scenario's robot's, or that do not start at the scenario's start
+  // (the guide author's first key posture is the start exactly).
+  static std::string earlyGuideProblem(const guide_t& g, const Scenario& sc, std::vector<Configuration>& q) {
     if (g.status != guide_t::OK) return "status " + std::to_string(g.status) + ": " + g.reason;
-    std::vector<Configuration> q;
     try {
       q = guidePostures(g, sc);
     } catch (const std::exception& e) {
@@ -205,14 +205,20 @@ class PlannerService : public proc::Service {
       status_.idle();
       return;
     }
+    std::vector<Configuration> q;
     try {
-      const std::vector<Configuration> q = guidePostures(g, *sc);
-      sc->key_postures.insert(sc->key_postures.end(), q.begin(), q.end());
+      q = guidePostures(g, *sc);
     } catch (const std::exception& e) {
       refuse(req, plan_t::INVALID_INPUT, std::string("the guide cannot be read: ") + e.what());
       status_.idle();
       return;
     }
+    planOnGuide(req, sc, params, g, q);
+  }
+  // The guide's key postures (read from g) into the scenario, then the search.
+  void planOnGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params,
+                   const guide_t& g, const std::vector<Configuration>& postures) {
+    sc->key_postures.insert(sc->key_postures.end(), postures.begin(), postures.end());
     proc::log(kProcess, "request " + std::to_string(req.request_id) + ": guide of " +
                             std::to_string(g.num_postures) + " key postures (" + g.source + ")");
     startPlanning(req, sc, params);
