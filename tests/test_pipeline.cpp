@@ -376,6 +376,20 @@ void publishMalformed(Client& c, const char* channel, const Msg& good, std::uint
   }
 }
 
+// A guide of `postures` copies of one 2-joint posture: no robot's (HRP-2 has 30).
+guide_t twoJointGuide(std::int64_t request_id, const std::string& source, int postures) {
+  guide_t g{};
+  g.request_id = request_id;
+  g.source = source;
+  configuration_t q{};
+  q.base_orientation[0] = 1;
+  q.num_joints = 2;
+  q.joints = {0.1, 0.2};
+  g.num_postures = postures;
+  g.postures.assign(postures, q);
+  return g;
+}
+
 // Malformed variants of every message the services subscribe to. The good
 // messages are refused when they do decode (a scenario that does not load),
 // so that no fuzzed variant starts real work.
@@ -392,15 +406,7 @@ void fuzzServiceChannels(Client& c) {
   cancel.request_id = 12345;
   cancel.reason = "fuzz";
   publishMalformed(c, channels::kCancel, cancel, 2);
-  guide_t g{};
-  g.request_id = 100;
-  g.source = "fuzz";
-  configuration_t q{};
-  q.base_orientation[0] = 1;
-  q.num_joints = 2;
-  q.joints = {0.1, 0.2};
-  g.num_postures = 1;
-  g.postures = {q};
+  const guide_t g = twoJointGuide(100, "fuzz", 1);
   publishMalformed(c, channels::kGuide, g, 3);
   plan_t plan{};
   plan.request_id = 101;
@@ -408,7 +414,7 @@ void fuzzServiceChannels(Client& c) {
   plan.num_joints = 1;
   plan.joint_names = {"J"};
   stance_t s{};
-  s.configuration = q;
+  s.configuration = g.postures[0];
   plan.num_stances = 1;
   plan.stances = {s};
   publishMalformed(c, channels::kPlan, plan, 4);
@@ -489,15 +495,7 @@ TEST(Pipeline, AForeignGuideThatComesBeforeItsRequestIsNotUsed) {
   for (const char* n : {"acyclic-guide", "acyclic-planner"}) p.start(n);
   for (const char* n : {"acyclic-guide", "acyclic-planner"})
     ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(n, process_status_t::IDLE); }, 20)) << n;
-  guide_t foreign{};
-  foreign.request_id = 9;
-  foreign.source = "elsewhere";
-  configuration_t q{};
-  q.base_orientation[0] = 1;
-  q.num_joints = 2;
-  q.joints = {0.1, 0.2};
-  foreign.num_postures = 2;
-  foreign.postures = {q, q};
+  guide_t foreign = twoJointGuide(9, "elsewhere", 2);
   c.bus.publish(channels::kGuide, foreign);
   c.waitFor([] { return false; }, 0.5);  // heard and stored
   std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
@@ -513,6 +511,7 @@ TEST(Pipeline, AForeignGuideThatComesBeforeItsRequestIsNotUsed) {
 
   // The robot's joints, but not from this scenario's start (a stale run's).
   foreign.request_id = 10;
+  configuration_t q = foreign.postures[0];
   q.num_joints = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml")).robot->numJoints();
   q.joints.assign(q.num_joints, 0.0);
   foreign.postures = {q, q};
