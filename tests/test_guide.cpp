@@ -38,6 +38,14 @@ void placeOnSurfaces(const Scenario& sc, const Kinematics& kin, std::vector<Cont
   }
 }
 
+// How many contacts of the plan's last stance support on the named surface.
+int supportingOnAtTheEnd(const Plan& plan, const Scenario& sc, const std::string& surface) {
+  int n = 0;
+  for (const auto& c : plan.stances.back().contacts)
+    n += c.spec.supporting && sc.scene->surfaces()[c.spec.surface].name == surface;
+  return n;
+}
+
 void expectGuideFor(const std::string& rel) {
   const Scenario sc = Scenario::load(test::sourcePath(rel));
   GuideResult r;
@@ -292,10 +300,7 @@ TEST(GuideAuthor, AStepUpIsGuidedUnderTheCeilingAndPlannedOntoThePlatform) {
   ASSERT_TRUE(r.solved()) << r.reason;
   ValidityChecker checker(sc.robot, sc.scene);
   EXPECT_TRUE(checkPlan(r.plan, sc, checker).valid());
-  int on_platform = 0;
-  for (const auto& c : r.plan.stances.back().contacts)
-    on_platform += c.spec.supporting && sc.scene->surfaces()[c.spec.surface].name == "platform_top";
-  EXPECT_EQ(on_platform, 2);
+  EXPECT_EQ(supportingOnAtTheEnd(r.plan, sc, "platform_top"), 2);
 
   // Without the ceiling the guide rises before the edge and the search fails.
   GuideOptions free;
@@ -396,10 +401,7 @@ TEST(GuideAuthor, SittingDownAtATableFromBesideItStandsInFrontOfTheSeatFirstAndI
   const PlanningResult r = ContactPlanner(sc, p).plan();
   ASSERT_TRUE(r.solved()) << r.reason;
   EXPECT_TRUE(checkPlan(r.plan, sc, checker).valid());
-  int on_seat = 0;
-  for (const auto& c : r.plan.stances.back().contacts)
-    on_seat += c.spec.supporting && sc.scene->surfaces()[c.spec.surface].name == "chair_seat";
-  EXPECT_EQ(on_seat, 2);
+  EXPECT_EQ(supportingOnAtTheEnd(r.plan, sc, "chair_seat"), 2);
 }
 
 // Ducking under a low beam (models/scenarios/duck_under_beam.yaml): no path
