@@ -126,6 +126,9 @@ int main(int argc, char** argv) {
                 "%ld pairs skipped by the failure memory, %ld calls solved ahead and not used\n",
                 sc.name.c_str(), acyclic::toString(r.status), s.seconds, s.nodes_generated, s.nodes_expanded,
                 s.posture_calls, s.posture_failures, s.pairs_remembered, s.calls_ahead_unused);
+    if (s.limb_retries > 0)
+      std::printf("acyclic-planner: %ld added contacts tried again with the guide's limb, %ld made so\n",
+                  s.limb_retries, s.limb_retry_successes);
     if (s.plans_verified > 0)
       std::printf("acyclic-planner: transitions verified: %ld plans checked, %ld refused, %ld transitions solved, "
                   "%.2f s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds);

@@ -930,3 +930,49 @@ TEST(PostureProblem, PyramidEdgesMustBeTheContractsEdges) {
   EXPECT_THROW(PostureProblem(sc.robot, sc.scene, collision, r, o), std::invalid_argument);
 }
 
+
+// A request's retry_guess: Ipopt is local, and HRP-2 kneeling on its right
+// knee (crawl_under_table's third key posture, the left sole flat) cannot put
+// its right palm on the floor from arms that hang at its sides (the wrist
+// must turn some 75 degrees); from the right arm as the next key posture
+// holds it, leaning onto the palms, it can. The generator tries the second
+// guess only when the first fails, and says so.
+TEST(PostureGenerator, ARetryGuessIsSolvedWhenTheFirstGuessFails) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/crawl_under_table.yaml"));
+  ASSERT_GE(sc.key_postures.size(), 4u);
+  const Configuration& kneeling = sc.key_postures[2];
+  const Configuration& leaning = sc.key_postures[3];
+  PostureRequest r;
+  r.contacts = {contactOf(sc, "l_sole", "floor", true, kneeling), contactOf(sc, "r_knee", "floor", true, kneeling)};
+  r.initial_guess = kneeling;
+  FloatingContact f;
+  f.spot = sc.robot->spotIndex("r_palm");
+  f.surface = sc.scene->surfaceIndex("floor");
+  f.volume.polygon = sc.scene->surfaces()[f.surface].polygon;
+  r.floating = f;
+  PostureGenerator pg(sc.robot, sc.scene);
+  {
+    ValidityChecker checker(sc.robot, sc.scene);
+    ASSERT_TRUE(checker.checkPosture(kneeling, r.contacts).valid());  // the stance itself holds
+  }
+  const PostureResult once = pg.solve(r);
+  EXPECT_FALSE(once.success()) << "the palm was put down from hanging arms: the retry is not tested";
+  EXPECT_EQ(once.solves, 1);
+
+  Configuration arm_forward = kneeling;
+  for (int j : sc.robot->jointsMovedBy(sc.robot->spotLimbRootJoint(f.spot))) arm_forward.joints[j] = leaning.joints[j];
+  r.retry_guess = arm_forward;
+  const PostureResult twice = pg.solve(r);
+  ASSERT_TRUE(twice.success()) << toString(twice.status) << ": " << twice.reason;
+  EXPECT_EQ(twice.solves, 2);
+  std::vector<ContactSpec> stance = r.contacts;
+  stance.push_back(placedContact(r, twice));
+  expectValid(sc, twice, stance);
+
+  // A first guess that succeeds is the answer: the retry is not solved.
+  PostureRequest easy = r;
+  easy.initial_guess = twice.configuration;
+  const PostureResult first = pg.solve(easy);
+  ASSERT_TRUE(first.success()) << first.reason;
+  EXPECT_EQ(first.solves, 1);
+}

@@ -214,6 +214,19 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
 PostureGenerator::~PostureGenerator() = default;
 
 PostureResult PostureGenerator::solve(const PostureRequest& request) {
+  PostureResult res = solveOnce(request);
+  if (res.success() || res.status == PostureResult::Status::BadInput || !request.retry_guess) return res;
+  PostureRequest again = request;
+  again.initial_guess = *request.retry_guess;
+  again.retry_guess.reset();
+  PostureResult second = solveOnce(again);
+  second.solves = 2;
+  second.iterations += res.iterations;
+  second.seconds += res.seconds;
+  return second;
+}
+
+PostureResult PostureGenerator::solveOnce(const PostureRequest& request) {
   const auto t0 = std::chrono::steady_clock::now();
   PostureResult res;
   res.configuration = request.initial_guess;

@@ -76,6 +76,7 @@ struct PostureResult {
   std::vector<PostureProblem::ContactForces> forces;  // per supporting contact
   double cost = 0;
   int iterations = 0;
+  int solves = 1;                     // 2 when the request's retry_guess was solved too
   double seconds = 0;                 // wall time
   bool success() const { return status == Status::Success; }
 };
@@ -90,7 +91,8 @@ class PostureGenerator {
   PostureGenerator(const PostureGenerator&) = delete;
   PostureGenerator& operator=(const PostureGenerator&) = delete;
 
-  // Solves one request. Not re-entrant: use one generator per thread.
+  // Solves one request (and again from its retry_guess when that fails).
+  // Not re-entrant: use one generator per thread.
   PostureResult solve(const PostureRequest& request);
 
   const PostureGeneratorOptions& options() const { return opt_; }
@@ -98,6 +100,7 @@ class PostureGenerator {
 
  private:
   struct Ipopt;
+  PostureResult solveOnce(const PostureRequest& request);
   std::shared_ptr<const RobotModel> robot_;
   std::shared_ptr<const Scene> scene_;
   std::shared_ptr<const CollisionModel> collision_;

@@ -75,6 +75,11 @@ struct PostureRequest {
   std::optional<PoseTarget> pose_target;    // at most one; rows after the floating contact's
   Configuration initial_guess;
   std::shared_ptr<const PostureCost> cost;  // default: distance to the initial guess
+  // Solved again from this guess when the solve from initial_guess fails
+  // (PostureGenerator::solve; the cost as it was: the default cost stays the
+  // distance to initial_guess). Ipopt is local: the planner retries an added
+  // contact with its limb where the guide holds it (guide_limb_guess).
+  std::optional<Configuration> retry_guess;
 };
 
 struct PostureOptions {

@@ -88,6 +88,7 @@ struct ContactPlanner::Impl {
   std::vector<std::unique_ptr<PostureGenerator>> pgs;  // one per thread
   ValidityChecker checker;
   Kinematics kin;  // the search is single-threaded: one for every key, goal and reach test
+  Kinematics key_kin;  // the key postures' contacts (guideLimb)
   CollisionModel collisions;  // the hanging limbs' swings (swing_check.h)
   std::unique_ptr<GuidePotential> guide;
   std::mt19937 rng;
@@ -146,7 +147,7 @@ struct ContactPlanner::Impl {
   std::string stop_reason;
 
   Impl(const Scenario& s, PlannerParameters params)
-      : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), collisions(s.robot, s.scene),
+      : sc(s), p(std::move(params)), checker(s.robot, s.scene), kin(s.robot), key_kin(s.robot), collisions(s.robot, s.scene),
         rng(s.seed) {
     for (int t = 0; t < std::max(1, p.threads); ++t)
       pgs.push_back(std::make_unique<PostureGenerator>(s.robot, s.scene, p.posture));
@@ -342,8 +343,9 @@ struct ContactPlanner::Impl {
     }
     for (std::size_t i = 0; i < rs.size(); ++i)
       if (b.ran[i]) {
-        ++stats.posture_calls;
+        stats.posture_calls += b.results[i].solves;  // a retry is a call
         if (!b.results[i].success()) ++stats.posture_failures;
+        if (b.results[i].solves > 1) ++stats.limb_retries, stats.limb_retry_successes += b.results[i].success();
       }
     return b;
   }
@@ -352,15 +354,16 @@ struct ContactPlanner::Impl {
   // never came): counted apart from the posture calls.
   void notUsed(const Batch& b, std::size_t i) {
     if (!b.ran[i]) return;
-    --stats.posture_calls;
+    stats.posture_calls -= b.results[i].solves;
+    if (b.results[i].solves > 1) --stats.limb_retries, stats.limb_retry_successes -= b.results[i].success();
     if (!b.results[i].success()) --stats.posture_failures;
     ++stats.calls_ahead_unused;
   }
 
   void traceCall(const std::string& what, const PostureResult& res) const {
     if (p.trace)
-      p.trace("  " + what + ": " + toString(res.status) + " (" + std::to_string(res.iterations) + " it, " +
-              std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
+      p.trace("  " + what + ": " + toString(res.status) + (res.solves > 1 ? " with the guide's limb" : "") + " (" +
+              std::to_string(res.iterations) + " it, " + std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
   }
 
   // The removal sons' requests of node ni: each contact geometric only in
@@ -397,6 +400,37 @@ struct ContactPlanner::Impl {
     addNode(son);
   }
 
+  // The joints of the limb carrying `spot` set as the guide holds them for
+  // the contact (PlannerParameters::guide_limb_guess): from the key posture
+  // in which the spot touches `surface` (within 1 cm of its plane, over its
+  // polygon, normals opposed within 0.3 rad) whose base is nearest q's. The
+  // guide at q itself may not hold the limb there yet: a knee that goes
+  // down is still a squatting leg in the guide until the posture with the
+  // knee on the floor. False when no key posture holds the spot there, or
+  // taking its limb changes nothing (1e-3 rad).
+  bool guideLimb(int spot, int surface, Configuration& q) {
+    const int root = sc.robot->spotLimbRootJoint(spot);
+    if (root < 0) return false;
+    const Surface& surf = sc.scene->surfaces()[surface];
+    const Configuration* best = nullptr;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Configuration& key : sc.key_postures) {
+      key_kin.setConfiguration(key);
+      const Eigen::Isometry3d f = surf.frame.inverse() * key_kin.spotPose(spot);
+      const bool touches = std::abs(f.translation().z()) <= 0.01 && f.linear()(2, 2) >= std::cos(0.3) &&
+                           surf.polygon.contains(f.translation().head<2>());
+      const double d = (key.base_position - q.base_position).norm();
+      if (touches && d < nearest) nearest = d, best = &key;
+    }
+    if (!best) return false;
+    double moved = 0;
+    for (int j : sc.robot->jointsMovedBy(root)) {
+      moved = std::max(moved, std::abs(q.joints[j] - best->joints[j]));
+      q.joints[j] = best->joints[j];
+    }
+    return moved > 1e-3;
+  }
+
   // A pair generator's next request: its best remaining volume (or a random
   // sample); false when it has none left.
   struct Candidate {
@@ -411,6 +445,10 @@ struct ContactPlanner::Impl {
     r = PostureRequest();
     r.contacts = n.contacts;
     r.initial_guess = n.q;
+    if (p.guide_limb_guess && guide) {
+      Configuration q = n.q;
+      if (guideLimb(g.spot, g.surface, q)) r.retry_guess = q;
+    }
     r.cost = costFrom(n.q);
     ContactSpec& added = cand.added;
     added = ContactSpec();

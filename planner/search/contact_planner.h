@@ -82,6 +82,15 @@ struct PlannerParameters {
   // foot below a thigh on the seat) cannot swing from the parent's witness
   // to its own clear of the obstacles is refused (swing_check.h).
   bool swing_check = true;
+  // An added contact that fails from the parent's witness is tried once
+  // more (beyond the paper) with the joints of the limb that carries it (hip
+  // to foot, shoulder to hand) as the key posture nearest the witness that
+  // has the spot on that surface holds them. Ipopt is local: a knee put
+  // down needs the shank swung back, a palm the wrist turned 75 degrees,
+  // and from the limb where the parent holds it the solve can end locally
+  // infeasible. Off by default (a retry changes the tree wherever a call
+  // failed); crawl_under_table sets it.
+  bool guide_limb_guess = false;
   // Lazy verification of the transitions (beyond the paper): a plan the
   // search finds is handed to verify_plan (in processes: the interpolator's
   // transition solver, interpolator/plan_verifier.h); when one of its
@@ -110,6 +119,9 @@ struct PlanningStats {
   long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
   long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
   long calls_ahead_unused = 0;  // solved ahead on an idle generator, their turn never came (not in posture_calls)
+  // guide_limb_guess: added contacts solved again from the guide's limb, and
+  // how many of those the retry made (both within posture_calls).
+  long limb_retries = 0, limb_retry_successes = 0;
   double seconds = 0, best_potential = 0;
   // Lazy verification (verify_transitions): plans handed to the verifier,
   // refused by it, transitions solved, and the wall time spent in it.
