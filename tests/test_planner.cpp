@@ -2,6 +2,7 @@
 // budgets with reasons, cancellation, bad starts, and each ablation switch.
 #include <gtest/gtest.h>
 
+#include <set>
 #include <thread>
 
 #include "planner/check/plan_check.h"
@@ -508,4 +509,34 @@ TEST(ContactPlanner, ARefusedTransitionIntoASettledStanceGetsItsNextWitnessFirst
     if (k == 2) continue;
     EXPECT_EQ(r.plan.stances[k].configuration.joints, plain.plan.stances[k].configuration.joints) << k;
   }
+}
+
+// Getting down on all fours (crawl_under_table's first five key postures,
+// the goal: both knees and both palms on the floor, supporting): the
+// planner gets HRP-2 from standing onto its knees and palms, every stance
+// valid, an added contact that fails from the parent's limb tried again
+// from the limb as the key posture with that contact holds it
+// (guide_limb_guess), and some are made only so.
+TEST(ContactPlanner, HRP2GetsDownOnAllFoursFromStanding) {
+  test::TempDir dir;
+  std::string text = test::scenarioText("models/scenarios/crawl_under_table.yaml");
+  const std::string goal = "goal: {link: WAIST, axis: x, min: 1.0}";
+  ASSERT_NE(text.find(goal), std::string::npos);
+  text.replace(text.find(goal), goal.size(),
+               "goal: {link: WAIST, axis: x, min: -1.0, supported_by: [r_knee, l_knee, r_palm, l_palm]}");
+  const std::size_t last_key = text.find("  # 6. on all fours");
+  const std::size_t planner = text.find("\nplanner:");
+  ASSERT_NE(last_key, std::string::npos);
+  ASSERT_NE(planner, std::string::npos);
+  text = text.substr(0, last_key) + "\nplanner: {guide_limb_guess: true, max_nodes: 2000}\n";
+  const Scenario sc = Scenario::load(dir.write("kneel.yaml", text));
+  const PlanningResult r = ContactPlanner(sc, plannerParameters(sc)).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);
+  std::set<std::string> supporting;
+  for (const auto& c : r.plan.stances.back().contacts)
+    if (c.spec.supporting) supporting.insert(sc.robot->spots()[c.spec.spot].name);
+  EXPECT_EQ(supporting, (std::set<std::string>{"l_knee", "l_palm", "r_knee", "r_palm"}));
+  EXPECT_GT(r.stats.limb_retry_successes, 0);
+  EXPECT_LE(r.stats.limb_retry_successes, r.stats.limb_retries);
 }
