@@ -26,7 +26,9 @@ int main(int argc, char** argv) {
       "to whole-body key postures. For a goal resting on spots the start lacks (sitting down) from a start\n"
       "not in line with it, through an approach posture standing in front of it first. Where standing\n"
       "postures find no path within half the budget (a low beam), again with a crouch coordinate (the\n"
-      "start stance lowered on its feet) in the space.\n"
+      "start stance lowered on its feet) in the space. Where nothing stands in the goal region (under a\n"
+      "low table), the robot's crawling posture there, reached by getting down where it starts (a squat,\n"
+      "a knee, the palms, the other knee: each a posture-generator witness) and then crawling.\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
       "File mode: --in SCENARIO --out GUIDE; exit status 0 written, 1 no guide (reason printed), 2 bad input.\n"
       "LCM mode: --lcm answers every ACYCLIC_REQUEST whose scenario has no key postures with ACYCLIC_GUIDE\n"
@@ -48,8 +50,11 @@ int main(int argc, char** argv) {
   app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
   bool no_crouch = false;
   app.add_flag("--no-crouch", no_crouch, "standing postures only: no second try with a crouch");
+  bool no_crawl = false;
+  app.add_flag("--no-crawl", no_crawl, "no crawling goal posture where nothing stands in the goal region");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.crouch = !no_crouch;
+  o.crawl = !no_crawl;
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   proc::installSignalHandlers();
   if (lcm_mode) return serveGuide(url, o);
@@ -74,6 +79,9 @@ int main(int argc, char** argv) {
                 out.c_str());
     if (r.approach) std::printf("acyclic-guide: through an approach posture standing in front of the goal\n");
     if (r.crouch) std::printf("acyclic-guide: crouched: no path of standing postures\n");
+    if (r.crawl)
+      std::printf("acyclic-guide: crawling: nothing stands in the goal region; down on the '%s' posture's contacts "
+                  "at key posture %d\n", o.crawling_posture.c_str(), r.crawl_index + 1);
     return 0;
   } catch (const FormatError& e) {
     std::fprintf(stderr, "acyclic-guide: %s\n", e.what());

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <set>
 
 #include "planner/check/plan_check.h"
 #include "planner/check/validity.h"
@@ -438,4 +439,70 @@ TEST(GuideAuthor, ALowBeamIsPassedCrouchedAndPlanned) {
   double lowest = standing;
   for (const auto& st : r.plan.stances) lowest = std::min(lowest, st.configuration.base_position.z());
   EXPECT_LT(lowest, standing - 0.15) << "walked under the beam crouched";
+}
+
+// Under a low table nothing stands in the goal region: the guide author
+// ends on the robot's crawling posture (knees and palms on the floor) and
+// gets down onto it where the robot starts, each posture of the way down a
+// valid stance on the contacts it makes (the check, on contacts found from
+// the posture's own spots): both soles, then one sole and a knee, ..., both
+// knees and both palms. Without the crawl it says why.
+TEST(GuideAuthor, UnderALowTableTheGuideGetsDownOnAllFoursAndCrawls) {
+  test::TempDir dir;
+  std::string text = test::scenarioText("models/scenarios/crawl_under_table.yaml");
+  const std::size_t keys = text.find("key_postures:"), planner = text.find("\nplanner:");
+  ASSERT_NE(keys, std::string::npos);
+  ASSERT_NE(planner, std::string::npos);
+  text.erase(keys, planner + 1 - keys);
+  const Scenario sc = Scenario::load(dir.write("crawl.yaml", text));
+  ASSERT_TRUE(sc.key_postures.empty());
+
+  GuideOptions no_crawl;
+  no_crawl.crawl = false;
+  const GuideResult refused = authorGuide(sc, no_crawl);
+  EXPECT_EQ(refused.status, GuideResult::Status::NoGoalPosture);
+
+  GuideResult g;
+  ASSERT_NO_FATAL_FAILURE(expectGuideFromTheStart(sc, g));
+  ASSERT_TRUE(g.crawl);
+  const auto& k = g.guide.key_postures;
+  ASSERT_GT(g.crawl_index, 2);
+  ASSERT_LT(g.crawl_index, static_cast<int>(k.size()) - 1);
+  Kinematics kin(sc.robot);
+  ValidityChecker checker(sc.robot, sc.scene);
+  const int floor = sc.scene->surfaceIndex("floor");
+  // The spots of a key posture within 1 mm of the floor, facing it.
+  auto onTheFloor = [&](const Configuration& q) {
+    kin.setConfiguration(q);
+    std::vector<ContactSpec> out;
+    for (int spot : sc.allowed_spots) {
+      const Eigen::Isometry3d f = sc.scene->surfaces()[floor].frame.inverse() * kin.spotPose(spot);
+      if (std::abs(f.translation().z()) > 1e-3 || f.linear()(2, 2) < 0.95) continue;
+      ContactSpec c;
+      c.spot = spot;
+      c.surface = floor;
+      out.push_back(c);
+    }
+    placeOnSurfaces(sc, kin, out);
+    return out;
+  };
+  auto names = [&](const std::vector<ContactSpec>& cs) {
+    std::set<std::string> n;
+    for (const auto& c : cs) n.insert(sc.robot->spots()[c.spot].name);
+    return n;
+  };
+  for (int i = 1; i <= g.crawl_index; ++i) {
+    const std::vector<ContactSpec> stance = onTheFloor(k[i]);
+    SCOPED_TRACE("key posture " + std::to_string(i));
+    EXPECT_GE(stance.size(), 2u);
+    EXPECT_TRUE(checker.checkPosture(k[i], stance).valid());
+  }
+  EXPECT_EQ(names(onTheFloor(k[1])), (std::set<std::string>{"l_sole", "r_sole"}));  // the squat
+  EXPECT_EQ(names(onTheFloor(k[g.crawl_index])), (std::set<std::string>{"l_knee", "l_palm", "r_knee", "r_palm"}));
+  EXPECT_EQ(names(onTheFloor(k.back())), (std::set<std::string>{"l_knee", "l_palm", "r_knee", "r_palm"}));
+  kin.setConfiguration(k.back());
+  EXPECT_TRUE(sc.goal.linkWithinBounds(kin));
+  for (std::size_t i = g.crawl_index; i < k.size(); ++i)
+    EXPECT_LT(k[i].base_position.z(), 0.45) << "crawls: key posture " << i;
+  EXPECT_NO_THROW(GuidePotential(k, 1.0, 0.05));
 }

@@ -208,6 +208,16 @@ Eigen::Vector3d surfaceMiddle(const Surface& surf) {
   return surf.frame * Eigen::Vector3d(c.x(), c.y(), 0);
 }
 
+// A contact of `spot` floating over the whole of `surface` (touching, not
+// supporting): added as the planner adds one.
+FloatingContact overSurface(const Scenario& sc, int spot, int surface) {
+  FloatingContact f;
+  f.spot = spot;
+  f.surface = surface;
+  f.volume.polygon = sc.scene->surfaces()[surface].polygon;
+  return f;
+}
+
 // A goal posture: a witness of `contacts` (placed where `q` puts their spots)
 // from the guess q, accepted by the independent check, in the goal (the
 // link's bound, and the supports the goal names).
@@ -241,11 +251,7 @@ bool addSupports(const Scenario& sc, PostureGenerator& pg, ValidityChecker& chec
     PostureRequest r;
     r.contacts = stance;
     r.initial_guess = q;
-    FloatingContact f;
-    f.spot = s;
-    f.surface = surface;
-    f.volume.polygon = surf.polygon;
-    r.floating = f;
+    r.floating = overSurface(sc, s, surface);
     const PostureResult res = pg.solve(r);
     if (!res.success()) return false;
     q = res.configuration;
@@ -377,11 +383,7 @@ bool goalPostureSeated(const Scenario& sc, const GuideOptions& o, PostureGenerat
         PostureRequest a;
         a.contacts = stance;
         a.initial_guess = at;
-        FloatingContact f;
-        f.spot = other.spot;
-        f.surface = other.surface;
-        f.volume.polygon = on.polygon;
-        a.floating = f;
+        a.floating = overSurface(sc, other.spot, other.surface);
         const PostureResult ar = pg.solve(a);
         if (!ar.success()) {
           added = false;
@@ -575,6 +577,196 @@ bool crouchOffsets(const Scenario& sc, PostureTools& t, Eigen::VectorXd& offsets
   return false;
 }
 
+// The contacts a posture makes: each allowed spot within 1 cm of an allowed
+// surface's plane, over its polygon, its frame's z within 0.3 rad of the
+// surface's outward normal (as in contact), supporting, placed where the
+// posture holds it. Each spot on one surface at most.
+std::vector<ContactSpec> contactsMadeBy(const Scenario& sc, Kinematics& kin, const Configuration& q) {
+  kin.setConfiguration(q);
+  std::vector<ContactSpec> out;
+  for (int spot : sc.allowed_spots)
+    for (int si : sc.allowed_surfaces) {
+      const Surface& surf = sc.scene->surfaces()[si];
+      const Eigen::Isometry3d f = surf.frame.inverse() * kin.spotPose(spot);
+      if (std::abs(f.translation().z()) > 0.01 || f.linear()(2, 2) < std::cos(0.3) ||
+          !surf.polygon.contains(f.translation().head<2>()))
+        continue;
+      ContactSpec c;
+      c.spot = spot;
+      c.surface = si;
+      c.placement = projectOnSurface(surf, kin.spotPose(spot));
+      out.push_back(c);
+      break;
+    }
+  return out;
+}
+
+// The robot's crawling posture (GuideOptions::crawling_posture) turned to
+// the start's heading, its base over `xy`, raised to the start's floor:
+// a witness of the contacts it makes there, accepted by the check. nullopt
+// when the robot has no such posture, it makes fewer than three contacts
+// there, or none is valid.
+std::optional<Configuration> crawlingAt(const Scenario& sc, const GuideOptions& o, PostureTools& t, int floor,
+                                        const Eigen::Vector2d& xy, std::vector<ContactSpec>& contacts) {
+  const RobotModel& m = *sc.robot;
+  if (!m.postures().count(o.crawling_posture)) return std::nullopt;
+  Configuration q = m.posture(o.crawling_posture);
+  const double yaw = yawOf(sc.start.base_orientation);
+  q.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * q.base_orientation;
+  q.base_position.head<2>() = xy;
+  q.base_position.z() += sc.scene->surfaces()[floor].frame.translation().z();
+  contacts = contactsMadeBy(sc, t.kin, q);
+  if (contacts.size() < 3) return std::nullopt;
+  const auto w = witnessNear(t.pg, contacts, q, q);
+  if (!w || !t.checker.checkPosture(*w, contacts).valid()) return std::nullopt;
+  return w;
+}
+
+// A crawling goal posture: where no posture stands in the goal region (under
+// a low table), the robot's crawling posture with its goal link past the
+// goal's bound, the free horizontal coordinate tried around the start's as
+// for standing; in the goal. False when there is none.
+bool goalPostureCrawling(const Scenario& sc, const GuideOptions& o, PostureTools& t, int floor, Configuration& out,
+                         std::vector<ContactSpec>& contacts) {
+  const RobotModel& m = *sc.robot;
+  const GoalCondition& g = sc.goal;
+  if (!m.postures().count(o.crawling_posture) || g.axis == 2) return false;
+  Configuration named = m.posture(o.crawling_posture);
+  const double yaw = yawOf(sc.start.base_orientation);
+  named.base_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * named.base_orientation;
+  t.kin.setConfiguration(named);
+  const Eigen::Vector3d offset = t.kin.linkPose(g.link).translation() - named.base_position;
+  const double bound = std::isfinite(g.min) ? g.min + o.goal_margin : g.max - o.goal_margin;
+  const int free_axis = g.axis == 0 ? 1 : 0;
+  std::vector<double> offsets = {0.0};
+  for (double d = 0.1; d <= o.goal_search + 1e-9; d += 0.1) offsets.push_back(d), offsets.push_back(-d);
+  for (double off : offsets) {
+    Eigen::Vector2d xy = sc.start.base_position.head<2>();
+    xy[g.axis] = bound - offset[g.axis];
+    xy[free_axis] += off;
+    const auto q = crawlingAt(sc, o, t, floor, xy, contacts);
+    if (!q) continue;
+    t.kin.setConfiguration(*q);
+    if (!sc.goal.satisfied(t.kin, contacts)) continue;
+    out = *q;
+    return true;
+  }
+  return false;
+}
+
+// Getting down from the start stance onto the crawling posture's contacts,
+// as a person does and as the planner can follow (key postures, each a
+// witness the check accepts): squat on the start's contacts; then for each
+// start contact on a limb the crawl also uses (a sole, whose leg kneels),
+// that contact released and the limb's crawl contact (the knee) put down;
+// before the last of them, the crawl's contacts on limbs the start does not
+// use (the palms). An added contact starts from the limb as `crawl` holds
+// it, and if that fails with the trunk too (the chest bent toward the
+// palms): Ipopt is local. `keys` gets the start and each witness; false
+// with `why` when a step finds no valid posture.
+bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl,
+                 const std::vector<ContactSpec>& crawl_contacts, std::vector<Configuration>& keys, std::string& why) {
+  const RobotModel& m = *sc.robot;
+  std::vector<ContactSpec> stance = sc.start_stance;
+  Configuration q = sc.start;
+  keys = {sc.start};
+  auto limbOf = [&](int spot) { return m.spotLimbRootJoint(spot); };
+  auto settle = [&](const std::string& what) {  // the stance with every contact supporting
+    for (auto& c : stance) c.supporting = true;
+    const auto w = witnessNear(t.pg, stance, q, q);
+    if (!w || !t.checker.checkPosture(*w, stance).valid()) {
+      why = "getting down: no valid posture once " + what;
+      return false;
+    }
+    q = *w;
+    return true;
+  };
+  {  // the squat
+    Configuration lowered = sc.start;
+    lowered.base_position.z() -= 0.25;
+    const auto squat = witnessNear(t.pg, stance, q, lowered);
+    if (!squat || !t.checker.checkPosture(*squat, stance).valid()) {
+      why = "getting down: the start stance has no valid squat";
+      return false;
+    }
+    q = *squat;
+    keys.push_back(q);
+  }
+  auto add = [&](const ContactSpec& target) {
+    const std::string name = m.spots()[target.spot].name;
+    const Surface& surf = sc.scene->surfaces()[target.surface];
+    Configuration limb = q;
+    for (int j : m.jointsMovedBy(limbOf(target.spot))) limb.joints[j] = crawl.joints[j];
+    Configuration trunk = limb;  // and the joints above the limb (the chest)
+    for (int j : m.ancestorJoints(m.spots()[target.spot].link)) trunk.joints[j] = crawl.joints[j];
+    PostureRequest r;
+    r.contacts = stance;
+    r.floating = overSurface(sc, target.spot, target.surface);
+    for (const Configuration* guess : {&limb, &trunk}) {
+      r.initial_guess = *guess;
+      r.cost = std::make_shared<ReferencePostureCost>(*guess, 0.01, 10.0, 1.0);
+      const PostureResult res = t.pg.solve(r);
+      if (!res.success()) continue;
+      ContactSpec c = target;
+      t.kin.setConfiguration(res.configuration);
+      c.placement = projectOnSurface(surf, t.kin.spotPose(target.spot));
+      c.supporting = false;
+      std::vector<ContactSpec> touching = stance;
+      touching.push_back(c);
+      if (!t.checker.checkPosture(res.configuration, touching).valid()) continue;
+      q = res.configuration;
+      stance = touching;
+      return settle(name + " is put down");
+    }
+    why = "getting down: " + name + " cannot be put down";
+    return false;
+  };
+  auto release = [&](std::size_t i) {
+    const std::string name = m.spots()[stance[i].spot].name;
+    std::vector<ContactSpec> r = stance;
+    r[i].supporting = false;
+    const auto w = witnessNear(t.pg, r, q, q);
+    if (!w || !t.checker.checkPosture(*w, r).valid()) {
+      why = "getting down: " + name + " cannot be released";
+      return false;
+    }
+    q = *w;
+    stance.erase(stance.begin() + static_cast<long>(i));
+    return true;
+  };
+  // Start contacts whose limb the crawl uses, each with its crawl contact.
+  std::vector<std::pair<int, ContactSpec>> swaps;  // start spot, crawl contact
+  std::vector<ContactSpec> others;                 // crawl contacts on limbs the start does not use
+  for (const auto& k : crawl_contacts) {
+    bool paired = false;
+    for (const auto& c : sc.start_stance)
+      if (c.spot != k.spot && limbOf(c.spot) >= 0 && limbOf(c.spot) == limbOf(k.spot)) {
+        swaps.push_back({c.spot, k});
+        paired = true;
+      }
+    bool held = false;
+    for (const auto& c : sc.start_stance) held = held || c.spot == k.spot;
+    if (!paired && !held) others.push_back(k);
+  }
+  if (swaps.empty()) {
+    why = "getting down: no start contact is on a limb the crawling posture rests on";
+    return false;
+  }
+  for (std::size_t s = 0; s < swaps.size(); ++s) {
+    if (s + 1 == swaps.size())
+      for (const auto& k : others) {
+        if (!add(k)) return false;
+        keys.push_back(q);
+      }
+    std::size_t i = 0;
+    while (i < stance.size() && stance[i].spot != swaps[s].first) ++i;
+    if (i == stance.size()) continue;
+    if (!release(i) || !add(swaps[s].second)) return false;
+    keys.push_back(q);
+  }
+  return true;
+}
+
 // One leg of the rough trajectory: OMPL's RRTConnect in the reduced space
 // blending `from` into `to` within `budget` seconds, shortcut, its vertices
 // lifted to whole-body postures (the first `from`, the last `to` exactly).
@@ -690,6 +882,54 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const LegEnds& ends, dou
   return true;
 }
 
+// Appends a leg's postures to the guide, leaving out a posture whose base is
+// within 1 cm and 0.02 rad of the one before (the guide's base projection
+// must be one-to-one).
+void appendKeys(Guide& g, const std::vector<Configuration>& postures) {
+  for (const Configuration& q : postures) {
+    if (!g.key_postures.empty() && (q.base_position - g.key_postures.back().base_position).norm() < 0.01 &&
+        q.base_orientation.angularDistance(g.key_postures.back().base_orientation) < 0.02)
+      continue;
+    g.key_postures.push_back(q);
+  }
+}
+
+// The guide of a crawl: getting down where the robot starts (gettingDown),
+// then OMPL's leg from the crawling posture there to the crawling goal
+// posture (the blend between two crawling postures: the base's path).
+GuideResult crawlGuide(const Scenario& sc, const GuideOptions& o, PostureTools& t, int floor, const Configuration& goal,
+                       const std::vector<ContactSpec>& crawl_contacts, double t0, const std::atomic<bool>* cancel,
+                       GuideResult& out) {
+  std::vector<Configuration> down;
+  if (!gettingDown(sc, t, goal, crawl_contacts, down, out.reason)) {
+    out.status = GuideResult::Status::NoPath;
+    return out;
+  }
+  out.crawl = true;
+  // Then the crawling posture itself a step ahead (the limbs as a crawl
+  // holds them, not as getting down left them): the valley the planner's
+  // first crawl steps follow.
+  const double yaw = yawOf(sc.start.base_orientation);
+  std::vector<ContactSpec> contacts;
+  const Eigen::Vector2d ahead =
+      down.back().base_position.head<2>() + o.crawl_step * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+  if (const auto crawling = crawlingAt(sc, o, t, floor, ahead, contacts)) down.push_back(*crawling);
+  const LegEnds ends{down.back(), goal, "crawling posture where the robot got down", "crawling goal posture"};
+  std::vector<Configuration> leg;
+  if (!planLeg(sc, o, ends, o.max_seconds, 0, {}, 0, cancel, out, leg)) return out;
+  Guide& g = out.guide;
+  g.source = "ompl";
+  g.scenario = sc.path;
+  appendKeys(g, down);
+  out.crawl_index = static_cast<int>(g.key_postures.size()) - 1;
+  appendKeys(g, leg);
+  g.seconds = now() - t0;
+  out.goal_seconds = g.seconds - out.path_seconds;
+  out.status = GuideResult::Status::Success;
+  out.reason.clear();
+  return out;
+}
+
 }  // namespace
 
 GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::atomic<bool>* cancel) {
@@ -699,8 +939,19 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   Configuration goal;
   PostureTools tools(sc);
   if (!goalPosture(sc, o, tools, goal, out.reason)) {
-    out.status = GuideResult::Status::NoGoalPosture;
-    return out;
+    // Where nothing stands in the goal region (under a low table): crawling.
+    int floor = -1;
+    for (const auto& c : sc.start_stance)
+      if (floor < 0 && sc.scene->surfaces()[c.surface].frame.linear().col(2).z() >= kLevelSurface) floor = c.surface;
+    std::vector<ContactSpec> crawl_contacts;
+    if (!o.crawl || floor < 0 || !goalPostureCrawling(sc, o, tools, floor, goal, crawl_contacts)) {
+      if (o.crawl && sc.robot->postures().count(o.crawling_posture) && sc.goal.axis != 2)
+        out.reason += ", nor a crawling posture ('" + o.crawling_posture + "')";
+      out.status = GuideResult::Status::NoGoalPosture;
+      return out;
+    }
+    out.goal_seconds = now() - t0;
+    return crawlGuide(sc, o, tools, floor, goal, crawl_contacts, t0, cancel, out);
   }
   out.goal_seconds = now() - t0;  // the goal posture (and at the end, every posture made)
   // One budget for every search (GuideOptions::max_seconds); the tries
@@ -760,15 +1011,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   g.source = "ompl";
   g.scenario = sc.path;
   for (const auto& postures : legs) {
-    for (const Configuration& q : postures) {
-      // Consecutive key postures must differ in their base (the guide's base
-      // projection is one-to-one): a leg's first is the last one's end.
-      if (!g.key_postures.empty() &&
-          (q.base_position - g.key_postures.back().base_position).norm() < 0.01 &&
-          q.base_orientation.angularDistance(g.key_postures.back().base_orientation) < 0.02)
-        continue;
-      g.key_postures.push_back(q);
-    }
+    appendKeys(g, postures);  // a leg's first posture is the last one's end
     if (&postures == &legs.front() && approach_index >= 0) out.approach_index = static_cast<int>(g.key_postures.size()) - 1;
   }
   if (g.key_postures.size() < 2) {

@@ -41,6 +41,13 @@ struct GuideOptions {
   // Where no path of standing postures reaches the goal within half of
   // max_seconds, try again with a crouch coordinate (authorGuide).
   bool crouch = true;
+  // Where no posture stands in the goal region and the start stance cannot
+  // be carried there (under a low table): the robot's named crawling
+  // posture there, and getting down onto its contacts where the robot
+  // starts (authorGuide).
+  bool crawl = true;
+  std::string crawling_posture = "crawling";
+  double crawl_step = 0.1;      // m: the crawling posture this far ahead of where the robot got down
   unsigned seed = 1;
 };
 
@@ -53,6 +60,8 @@ struct GuideResult {
   bool approach = false;        // an approach posture before the goal posture (approachPosture)
   int approach_index = -1;      // its index in guide.key_postures
   bool crouch = false;          // the path needed the crouch coordinate (crouchOffsets)
+  bool crawl = false;           // the goal is crawling: the guide gets down first (gettingDown)
+  int crawl_index = -1;         // the key posture at which the robot is down on its crawl contacts
   double goal_seconds = 0, path_seconds = 0;
   bool success() const { return status == Status::Success; }
 };
