@@ -660,9 +660,11 @@ bool goalPostureCrawling(const Scenario& sc, const GuideOptions& o, PostureTools
 // start contact on a limb the crawl also uses (a sole, whose leg kneels),
 // that contact released and the limb's crawl contact (the knee) put down;
 // before the last of them, the crawl's contacts on limbs the start does not
-// use (the palms). An added contact starts from the limb as `crawl` holds
-// it, and if that fails with the trunk too (the chest bent toward the
-// palms): Ipopt is local. `keys` gets the start and each witness; false
+// use (the palms). An added contact is tried from the posture before it
+// (a knee put down with the leg folded as the squat has it: swung straight
+// to the crawl's leg, the planner's plans on the guide could not be
+// interpolated), then from the limb as `crawl` holds it, then with the
+// trunk too (the chest bent toward the palms): Ipopt is local. `keys` gets the start and each witness; false
 // with `why` when a step finds no valid posture.
 bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl,
                  const std::vector<ContactSpec>& crawl_contacts, std::vector<Configuration>& keys, std::string& why) {
@@ -702,7 +704,8 @@ bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl
     PostureRequest r;
     r.contacts = stance;
     r.floating = overSurface(sc, target.spot, target.surface);
-    for (const Configuration* guess : {&limb, &trunk}) {
+    const Configuration here = q;
+    for (const Configuration* guess : std::initializer_list<const Configuration*>{&here, &limb, &trunk}) {
       r.initial_guess = *guess;
       r.cost = std::make_shared<ReferencePostureCost>(*guess, 0.01, 10.0, 1.0);
       const PostureResult res = t.pg.solve(r);
