@@ -81,6 +81,14 @@ struct Client {
         return &s;
     return nullptr;
   }
+  // A request for a shipped scenario with its key postures cut off: the
+  // guide process has to author them.
+  request_t requestWithoutKeyPostures(std::int64_t id, const std::string& scenario_rel) {
+    request_t r = request(id, scenario_rel);
+    const std::string text = test::scenarioText(scenario_rel);
+    r.scenario_yaml = text.substr(0, text.find("key_postures:"));
+    return r;
+  }
   request_t request(std::int64_t id, const std::string& scenario_rel, double budget_s = -1) {
     request_t r{};
     r.utime = proc::nowMicros();
@@ -467,12 +475,7 @@ TEST(Pipeline, FuzzOnEveryChannelLeavesEveryServiceUpAnsweringWithBoundedMemory)
   }
   // Still answering: a scenario without key postures needs the guide, then the
   // planner (and the interpolator after it).
-  test::TempDir dir;
-  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
-  text = text.substr(0, text.find("key_postures:"));
-  request_t good = c.request(8, "models/scenarios/step_forward.yaml");
-  good.scenario_yaml = text;
-  c.bus.publish(channels::kRequest, good);
+  c.bus.publish(channels::kRequest, c.requestWithoutKeyPostures(8, "models/scenarios/step_forward.yaml"));
   ASSERT_TRUE(c.waitFor([&] { return c.plans.count(8) > 0; }, 90));
   EXPECT_EQ(c.plans[8].status, +plan_t::OK) << c.plans[8].reason;
   if (haveInterpolator()) {
@@ -498,11 +501,7 @@ TEST(Pipeline, AForeignGuideThatComesBeforeItsRequestIsNotUsed) {
   guide_t foreign = twoJointGuide(9, "elsewhere", 2);
   c.bus.publish(channels::kGuide, foreign);
   c.waitFor([] { return false; }, 0.5);  // heard and stored
-  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
-  text = text.substr(0, text.find("key_postures:"));
-  request_t req = c.request(9, "models/scenarios/step_forward.yaml");
-  req.scenario_yaml = text;
-  c.bus.publish(channels::kRequest, req);
+  c.bus.publish(channels::kRequest, c.requestWithoutKeyPostures(9, "models/scenarios/step_forward.yaml"));
   ASSERT_TRUE(c.waitFor([&] { return c.plans.count(9) > 0; }, 90));
   EXPECT_EQ(c.plans[9].status, +plan_t::OK) << c.plans[9].reason;
   const process_status_t* set_aside = c.error("acyclic-planner", "came before it");
@@ -517,8 +516,7 @@ TEST(Pipeline, AForeignGuideThatComesBeforeItsRequestIsNotUsed) {
   foreign.postures = {q, q};
   c.bus.publish(channels::kGuide, foreign);
   c.waitFor([] { return false; }, 0.5);
-  req.request_id = 10;
-  c.bus.publish(channels::kRequest, req);
+  c.bus.publish(channels::kRequest, c.requestWithoutKeyPostures(10, "models/scenarios/step_forward.yaml"));
   ASSERT_TRUE(c.waitFor([&] { return c.plans.count(10) > 0; }, 90));
   EXPECT_EQ(c.plans[10].status, +plan_t::OK) << c.plans[10].reason;
   EXPECT_NE(c.error("acyclic-planner", "not the scenario's start"), nullptr);

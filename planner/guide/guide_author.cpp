@@ -185,6 +185,14 @@ std::optional<Configuration> witnessNear(PostureGenerator& pg, const std::vector
   return res.configuration;
 }
 
+// witnessNear, and only a witness the independent check accepts on `contacts`.
+std::optional<Configuration> checkedWitnessNear(PostureTools& t, const std::vector<ContactSpec>& contacts,
+                                                const Configuration& guess, const Configuration& reference) {
+  auto w = witnessNear(t.pg, contacts, guess, reference);
+  if (w && !t.checker.checkPosture(*w, contacts).valid()) w.reset();
+  return w;
+}
+
 // The start's contacts that are not among the goal's supports (the soles of
 // a robot that sits down).
 std::vector<ContactSpec> startContactsBesideSupports(const Scenario& sc) {
@@ -551,8 +559,8 @@ bool approachPosture(const Scenario& sc, const GuideOptions& o, PostureTools& t,
     kin.setConfiguration(q);
     std::vector<ContactSpec> stance = feet;
     if (!placeWhereHeld(sc, kin, stance)) continue;
-    const auto standing_there = witnessNear(t.pg, stance, q, q);
-    if (!standing_there || !t.checker.checkPosture(*standing_there, stance).valid()) continue;
+    const auto standing_there = checkedWitnessNear(t, stance, q, q);
+    if (!standing_there) continue;
     out = *standing_there;
     return true;
   }
@@ -567,8 +575,8 @@ bool crouchOffsets(const Scenario& sc, PostureTools& t, Eigen::VectorXd& offsets
   for (double d : {0.35, 0.30, 0.25, 0.20, 0.15}) {
     Configuration lowered = sc.start;
     lowered.base_position.z() -= d;
-    const auto squat = witnessNear(t.pg, sc.start_stance, sc.start, lowered);
-    if (!squat || !t.checker.checkPosture(*squat, sc.start_stance).valid()) continue;
+    const auto squat = checkedWitnessNear(t, sc.start_stance, sc.start, lowered);
+    if (!squat) continue;
     drop = sc.start.base_position.z() - squat->base_position.z();
     if (drop < 0.1) continue;  // not a crouch
     offsets = squat->joints - sc.start.joints;
@@ -587,10 +595,7 @@ std::vector<ContactSpec> contactsMadeBy(const Scenario& sc, Kinematics& kin, con
   for (int spot : sc.allowed_spots)
     for (int si : sc.allowed_surfaces) {
       const Surface& surf = sc.scene->surfaces()[si];
-      const Eigen::Isometry3d f = surf.frame.inverse() * kin.spotPose(spot);
-      if (std::abs(f.translation().z()) > 0.01 || f.linear()(2, 2) < std::cos(0.3) ||
-          !surf.polygon.contains(f.translation().head<2>()))
-        continue;
+      if (!spotNearSurface(surf, kin.spotPose(spot))) continue;
       ContactSpec c;
       c.spot = spot;
       c.surface = si;
@@ -617,9 +622,7 @@ std::optional<Configuration> crawlingAt(const Scenario& sc, const GuideOptions& 
   q.base_position.z() += sc.scene->surfaces()[floor].frame.translation().z();
   contacts = contactsMadeBy(sc, t.kin, q);
   if (contacts.size() < 3) return std::nullopt;
-  const auto w = witnessNear(t.pg, contacts, q, q);
-  if (!w || !t.checker.checkPosture(*w, contacts).valid()) return std::nullopt;
-  return w;
+  return checkedWitnessNear(t, contacts, q, q);
 }
 
 // A crawling goal posture: where no posture stands in the goal region (under
@@ -675,8 +678,8 @@ bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl
   auto limbOf = [&](int spot) { return m.spotLimbRootJoint(spot); };
   auto settle = [&](const std::string& what) {  // the stance with every contact supporting
     for (auto& c : stance) c.supporting = true;
-    const auto w = witnessNear(t.pg, stance, q, q);
-    if (!w || !t.checker.checkPosture(*w, stance).valid()) {
+    const auto w = checkedWitnessNear(t, stance, q, q);
+    if (!w) {
       why = "getting down: no valid posture once " + what;
       return false;
     }
@@ -686,8 +689,8 @@ bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl
   {  // the squat
     Configuration lowered = sc.start;
     lowered.base_position.z() -= 0.25;
-    const auto squat = witnessNear(t.pg, stance, q, lowered);
-    if (!squat || !t.checker.checkPosture(*squat, stance).valid()) {
+    const auto squat = checkedWitnessNear(t, stance, q, lowered);
+    if (!squat) {
       why = "getting down: the start stance has no valid squat";
       return false;
     }
@@ -728,8 +731,8 @@ bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl
     const std::string name = m.spots()[stance[i].spot].name;
     std::vector<ContactSpec> r = stance;
     r[i].supporting = false;
-    const auto w = witnessNear(t.pg, r, q, q);
-    if (!w || !t.checker.checkPosture(*w, r).valid()) {
+    const auto w = checkedWitnessNear(t, r, q, q);
+    if (!w) {
       why = "getting down: " + name + " cannot be released";
       return false;
     }

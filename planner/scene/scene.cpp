@@ -102,4 +102,10 @@ SurfacePlacement projectOnSurface(const Surface& s, const Eigen::Isometry3d& spo
   return p;
 }
 
+bool spotNearSurface(const Surface& s, const Eigen::Isometry3d& spot_world, double distance, double angle) {
+  const Eigen::Isometry3d local = s.frame.inverse() * spot_world;
+  return std::abs(local.translation().z()) <= distance && local.linear()(2, 2) >= std::cos(angle) &&
+         s.polygon.contains(local.translation().head<2>());
+}
+
 }  // namespace acyclic

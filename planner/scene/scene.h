@@ -53,5 +53,11 @@ Eigen::Isometry3d contactFrame(const Surface& s, const SurfacePlacement& p);
 // The placement of a spot frame projected on a surface (its offset along the
 // normal and its tilt are dropped; the contract checks them separately).
 SurfacePlacement projectOnSurface(const Surface& s, const Eigen::Isometry3d& spot_world);
+// Whether a spot frame rests on a surface, loosely (a key or named posture,
+// which holds its contacts only roughly): its origin within `distance` of
+// the surface's plane and over its polygon, its z within `angle` of the
+// surface's normal (as in contact).
+bool spotNearSurface(const Surface& s, const Eigen::Isometry3d& spot_world, double distance = 0.01,
+                     double angle = 0.3);
 
 }  // namespace acyclic

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <algorithm>
 #include <deque>
+#include <map>
 #include <cmath>
 #include <optional>
 #include <queue>
@@ -89,6 +90,7 @@ struct ContactPlanner::Impl {
   ValidityChecker checker;
   Kinematics kin;  // the search is single-threaded: one for every key, goal and reach test
   Kinematics key_kin;  // the key postures' contacts (guideLimb)
+  std::map<std::pair<int, int>, std::vector<std::size_t>> keys_holding;  // (spot, surface): key postures resting it there
   CollisionModel collisions;  // the hanging limbs' swings (swing_check.h)
   std::unique_ptr<GuidePotential> guide;
   std::mt19937 rng;
@@ -402,25 +404,25 @@ struct ContactPlanner::Impl {
 
   // The joints of the limb carrying `spot` set as the guide holds them for
   // the contact (PlannerParameters::guide_limb_guess): from the key posture
-  // in which the spot touches `surface` (within 1 cm of its plane, over its
-  // polygon, normals opposed within 0.3 rad) whose base is nearest q's. The
-  // guide at q itself may not hold the limb there yet: a knee that goes
-  // down is still a squatting leg in the guide until the posture with the
-  // knee on the floor. False when no key posture holds the spot there, or
-  // taking its limb changes nothing (1e-3 rad).
+  // in which the spot rests on `surface` (spotNearSurface) whose base is
+  // nearest q's. The guide at q itself may not hold the limb there yet: a
+  // knee that goes down is still a squatting leg in the guide until the
+  // posture with the knee on the floor. False when no key posture holds the
+  // spot there, or taking its limb changes nothing (1e-3 rad).
   bool guideLimb(int spot, int surface, Configuration& q) {
     const int root = sc.robot->spotLimbRootJoint(spot);
     if (root < 0) return false;
-    const Surface& surf = sc.scene->surfaces()[surface];
+    auto [holding, fresh] = keys_holding.try_emplace({spot, surface});
+    if (fresh)
+      for (std::size_t k = 0; k < sc.key_postures.size(); ++k) {
+        key_kin.setConfiguration(sc.key_postures[k]);
+        if (spotNearSurface(sc.scene->surfaces()[surface], key_kin.spotPose(spot))) holding->second.push_back(k);
+      }
     const Configuration* best = nullptr;
     double nearest = std::numeric_limits<double>::infinity();
-    for (const Configuration& key : sc.key_postures) {
-      key_kin.setConfiguration(key);
-      const Eigen::Isometry3d f = surf.frame.inverse() * key_kin.spotPose(spot);
-      const bool touches = std::abs(f.translation().z()) <= 0.01 && f.linear()(2, 2) >= std::cos(0.3) &&
-                           surf.polygon.contains(f.translation().head<2>());
-      const double d = (key.base_position - q.base_position).norm();
-      if (touches && d < nearest) nearest = d, best = &key;
+    for (std::size_t k : holding->second) {
+      const double d = (sc.key_postures[k].base_position - q.base_position).norm();
+      if (d < nearest) nearest = d, best = &sc.key_postures[k];
     }
     if (!best) return false;
     double moved = 0;
