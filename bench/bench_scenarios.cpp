@@ -20,6 +20,7 @@
 #include "interpolator/plan_verifier.h"
 #endif
 #include "planner/check/plan_check.h"
+#include "planner/common/fmt.h"
 #include "planner/guide/guide_author.h"
 #include "planner/posture/heap_tuning.h"
 #include "planner/search/planner_parameters.h"
@@ -42,6 +43,13 @@ int main(int argc, char** argv) {
                "verify each plan's transitions with the interpolator's solver, as acyclic-planner does by default "
                "(default here: the search alone, or the scenario's planner key verify_transitions)");
 #endif
+  GuideOptions guide_options;
+  app.add_flag("--stable-guide", guide_options.stable,
+               "scenarios without key postures: the OMPL guide through the statically stable subspace "
+               "(acyclic-guide --stable)");
+  app.add_flag("--edge-samples-guide", guide_options.sample_edges,
+               "scenarios without key postures: the OMPL guide's key postures sampled along its edges as with "
+               "--stable-guide, not projected (a control)");
   CLI11_PARSE(app, argc, argv);
   if (paths.empty()) {
     for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
@@ -56,9 +64,13 @@ int main(int argc, char** argv) {
     const bool guided = sc.key_postures.size() < 2;
     std::string guide_kind;
     if (guided) {
-      const GuideResult g = authorGuide(sc, GuideOptions());
-      guide_seconds = g.goal_seconds + g.path_seconds;
-      guide_kind = std::string(g.approach ? ", through an approach posture" : "") + (g.crouch ? ", crouched" : "");
+      const GuideResult g = authorGuide(sc, guide_options);
+      guide_seconds = g.goal_seconds + g.path_seconds + g.stable_seconds;
+      guide_kind = std::string(g.approach ? ", through an approach posture" : "") + (g.crouch ? ", crouched" : "") +
+                   (g.crawl ? ", crawling" : "") +
+                   (guide_options.stable ? fmt(", stable: %.0f projections, %.0f replans", g.stable_projections,
+                                               g.stable_replans)
+                                         : "");
       if (!g.success()) {
         std::printf("%-14s %-16s %9.2f  the OMPL guide author: %s\n", sc.name.c_str(), "no guide", guide_seconds,
                     g.reason.c_str());

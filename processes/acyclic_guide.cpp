@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
       "start stance lowered on its feet) in the space. Where nothing stands in the goal region (under a\n"
       "low table), the robot's crawling posture there, reached by getting down where it starts (a squat,\n"
       "a knee, the palms, the other knee: each a posture-generator witness) and then crawling.\n"
+      "With --stable, paths through the statically stable subspace: every key posture in static\n"
+      "equilibrium on the contacts it makes (section 7 of docs/design.md).\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
       "File mode: --in SCENARIO --out GUIDE; exit status 0 written, 1 no guide (reason printed), 2 bad input.\n"
       "LCM mode: --lcm answers every ACYCLIC_REQUEST whose scenario has no key postures with ACYCLIC_GUIDE\n"
@@ -52,6 +54,13 @@ int main(int argc, char** argv) {
   app.add_flag("--no-crouch", no_crouch, "standing postures only: no second try with a crouch");
   bool no_crawl = false;
   app.add_flag("--no-crawl", no_crawl, "no crawling goal posture where nothing stands in the goal region");
+  app.add_flag("--stable", o.stable,
+               "paths through the statically stable subspace (Bouyarmane 2009): samples along the path, each\n"
+               "projected by the posture generator onto a posture in static equilibrium on the contacts it\n"
+               "makes (checked); the leg replanned around a sample that does not project");
+  app.add_option("--stable-step", o.stable_step, "m of base travel between samples with --stable")->capture_default_str();
+  app.add_option("--stable-reach", o.stable_reach, "m: a spot this close to a surface rests on it, with --stable")
+      ->capture_default_str();
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.crouch = !no_crouch;
   o.crawl = !no_crawl;
@@ -78,6 +87,10 @@ int main(int argc, char** argv) {
                 sc.name.c_str(), g.key_postures.size(), r.path_vertices, g.seconds, r.goal_seconds, r.path_seconds,
                 out.c_str());
     if (r.approach) std::printf("acyclic-guide: through an approach posture standing in front of the goal\n");
+    if (o.stable)
+      std::printf("acyclic-guide: through the statically stable subspace: %d posture calls projecting samples in "
+                  "%.2f s, %d replans around samples that did not project\n",
+                  r.stable_projections, r.stable_seconds, r.stable_replans);
     if (r.crouch) std::printf("acyclic-guide: crouched: no path of standing postures\n");
     if (r.crawl)
       std::printf("acyclic-guide: crawling: nothing stands in the goal region; down on the '%s' posture's contacts "

@@ -312,6 +312,113 @@ TEST(GuideAuthor, AStepUpIsGuidedUnderTheCeilingAndPlannedOntoThePlatform) {
   EXPECT_FALSE(ContactPlanner(sc, p).plan().solved());
 }
 
+// The contacts a key posture makes, found here from its own spots (within
+// 1 mm of an allowed surface's plane, over its polygon, facing it), all
+// supporting: independent of the guide author's reach and tolerances.
+namespace {
+std::vector<ContactSpec> restingWithin1mm(const Scenario& sc, Kinematics& kin, const Configuration& q) {
+  kin.setConfiguration(q);
+  std::vector<ContactSpec> out;
+  for (int spot : sc.allowed_spots)
+    for (int si : sc.allowed_surfaces) {
+      const Surface& surf = sc.scene->surfaces()[si];
+      const Eigen::Isometry3d f = surf.frame.inverse() * kin.spotPose(spot);
+      if (std::abs(f.translation().z()) > 1e-3 || f.linear()(2, 2) < 0.95 ||
+          !surf.polygon.contains(f.translation().head<2>()))
+        continue;
+      ContactSpec c;
+      c.spot = spot;
+      c.surface = si;
+      c.placement = projectOnSurface(surf, kin.spotPose(spot));
+      out.push_back(c);
+      break;
+    }
+  return out;
+}
+}  // namespace
+
+// Paths through the statically stable subspace (GuideOptions::stable): on
+// step_up every key posture of the guide rests on the scene and the check
+// accepts it in equilibrium there, where the plain guide's blend floats up
+// toward the platform (some key posture without a stance the check
+// accepts); the planner plans on it to both soles on the platform.
+TEST(GuideAuthor, AStableGuideRestsEveryKeyPostureOnTheSceneInEquilibrium) {
+  Scenario sc = Scenario::load(test::sourcePath("models/scenarios/step_up.yaml"));
+  ASSERT_TRUE(sc.key_postures.empty());
+  Kinematics kin(sc.robot);
+  ValidityChecker checker(sc.robot, sc.scene);
+  auto inEquilibrium = [&](const Configuration& q) {
+    const std::vector<ContactSpec> stance = restingWithin1mm(sc, kin, q);
+    return !stance.empty() && checker.checkPosture(q, stance).valid();
+  };
+  const GuideResult plain = authorGuide(sc, GuideOptions());
+  ASSERT_TRUE(plain.success()) << plain.reason;
+  int floating = 0;
+  for (const auto& q : plain.guide.key_postures) floating += !inEquilibrium(q);
+  EXPECT_GT(floating, 0) << "the plain guide's blend is not in equilibrium everywhere";
+
+  GuideOptions o;
+  o.stable = true;
+  const GuideResult g = authorGuide(sc, o);
+  ASSERT_TRUE(g.success()) << g.reason;
+  EXPECT_GT(g.stable_projections, 0);
+  const auto& k = g.guide.key_postures;
+  EXPECT_GT(k.size(), plain.guide.key_postures.size()) << "sampled along the edges, not only at the vertices";
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    EXPECT_TRUE(inEquilibrium(k[i])) << "key posture " << i << " at " << k[i].base_position.transpose();
+    if (i > 0) EXPECT_LT((k[i].base_position - k[i - 1].base_position).head<2>().norm(), 0.25) << i;
+  }
+  EXPECT_EQ(k.front().joints, sc.start.joints);
+  kin.setConfiguration(k.back());
+  EXPECT_TRUE(sc.goal.linkWithinBounds(kin));
+  EXPECT_EQ(authorGuide(sc, o).guide.key_postures.back().joints, k.back().joints) << "deterministic";
+
+  sc.key_postures = k;
+  PlannerParameters p = plannerParameters(sc);
+  p.max_nodes = 1000;  // solved in 98: a node budget, not the machine's speed, bounds a failing run
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_TRUE(checkPlan(r.plan, sc, checker).valid());
+  EXPECT_EQ(supportingOnAtTheEnd(r.plan, sc, "platform_top"), 2);
+}
+
+// Across a gap in the floor 1 m wide that no stance spans (the floor's two
+// surfaces, the obstacle under them whole: the rough path is clear), the
+// plain guide crosses it; through the statically stable subspace there is
+// no path, after replanning around the samples that did not project, and
+// the reason says where the subspace ends and on which stance.
+TEST(GuideAuthor, AGapNoStanceSpansHasNoPathThroughTheStableSubspaceAndSaysWhere) {
+  test::TempDir dir;
+  dir.write("gap_floor.yaml",
+            "format: acyclic.scene/1\n"
+            "name: gap_floor\n"
+            "obstacles:\n"
+            "  - {name: floor, shape: box, size: [6, 6, 0.1], position: [0, 0, -0.05]}\n"
+            "surfaces:\n"
+            "  - {name: floor_near, obstacle: floor, position: [0, 0, 0], friction: 0.7,\n"
+            "     polygon: [[-3, -3], [0.3, -3], [0.3, 3], [-3, 3]]}\n"
+            "  - {name: floor_far, obstacle: floor, position: [0, 0, 0], friction: 0.7,\n"
+            "     polygon: [[1.3, -3], [3, -3], [3, 3], [1.3, 3]]}\n");
+  std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  const auto s = text.find("scene: ");
+  text.replace(s, text.find('\n', s) - s, "scene: " + dir.path() + "/gap_floor.yaml");
+  for (const char* c : {"surface: floor}", "surface: floor}"}) text.replace(text.find(c), 15, "surface: floor_near}");
+  text.replace(text.find("allowed_surfaces: [floor]"), 25, "allowed_surfaces: [floor_near, floor_far]");
+  text.replace(text.find("min: 0.25"), 9, "min: 1.60");
+  text.erase(text.find("key_postures:"));
+  const Scenario sc = Scenario::load(dir.write("gap.yaml", text));
+
+  const GuideResult plain = authorGuide(sc, GuideOptions());
+  ASSERT_TRUE(plain.success()) << plain.reason;
+  GuideOptions o;
+  o.stable = true;
+  const GuideResult g = authorGuide(sc, o);
+  EXPECT_EQ(g.status, GuideResult::Status::NoPath) << toString(g.status) << ": " << g.reason;
+  EXPECT_GE(g.stable_replans, o.stable_replans) << "planned again around the samples that did not project";
+  EXPECT_NE(g.reason.find("statically stable subspace"), std::string::npos) << g.reason;
+  EXPECT_NE(g.reason.find("r_sole@floor_near, l_sole@floor_near"), std::string::npos) << g.reason;
+}
+
 // Sitting down at a table: HRP-2 stands beside the chair of
 // models/scenes/chair_table.yaml, whose seat is 6 cm from the table's edge.
 // Carried toward the seat, the start stance meets the table or the seat's

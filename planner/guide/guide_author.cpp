@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/PathSimplifier.h>
@@ -15,7 +17,9 @@
 #include "planner/collision/collision_model.h"
 #include "planner/common/fmt.h"
 #include "planner/common/geometry.h"
+#include "planner/guide/guide_postures.h"
 #include "planner/guide/seeded_ompl.h"
+#include "planner/guide/stable_path.h"
 #include "planner/posture/posture_generator.h"
 
 namespace ob = ompl::base;
@@ -101,6 +105,9 @@ class RelaxedValidity : public ob::StateValidityChecker {
       : ob::StateValidityChecker(si), sc_(sc), lift_(lift), kin_(sc.robot), collision_(sc.robot, sc.scene),
         penetration_(penetration) {}
   void setCeiling(double above_ground) { ceiling_ = above_ground; }
+  // A ball of the reduced space left out (around a sample that did not
+  // project into the statically stable subspace).
+  void forbid(std::vector<double> centre, double radius) { forbidden_.push_back({std::move(centre), radius}); }
   const long& checks() const { return checks_; }  // states checked so far
   // The base's height above the ground within a step of it (the highest
   // under its point and the corners and edge middles of a square 2 kStep
@@ -119,6 +126,11 @@ class RelaxedValidity : public ob::StateValidityChecker {
   bool isValid(const ob::State* state) const override {
     ++checks_;
     const double* s = state->as<ob::RealVectorStateSpace::StateType>()->values;
+    for (const auto& [centre, radius] : forbidden_) {
+      double d2 = 0;
+      for (std::size_t k = 0; k < centre.size(); ++k) d2 += (s[k] - centre[k]) * (s[k] - centre[k]);
+      if (d2 < radius * radius) return false;
+    }
     if (ceiling_) {
       const auto h = heightAboveGround(s);
       if (h && *h > *ceiling_) return false;
@@ -139,6 +151,7 @@ class RelaxedValidity : public ob::StateValidityChecker {
   CollisionModel collision_;
   double penetration_;
   std::optional<double> ceiling_;
+  std::vector<std::pair<std::vector<double>, double>> forbidden_;
   mutable long checks_ = 0;
 };
 
@@ -153,44 +166,6 @@ bool placeWhereHeld(const Scenario& sc, const Kinematics& kin, std::vector<Conta
     on = on && surf.polygon.contains(Eigen::Vector2d(c.placement.x, c.placement.y));
   }
   return on;
-}
-
-// The guide author's posture tools, made once per guide: the posture
-// generator (200 iterations, 2 s a call), the independent check, kinematics.
-PostureGeneratorOptions guidePostureOptions() {
-  PostureGeneratorOptions po;
-  po.max_iterations = 200;
-  po.max_seconds = 2.0;
-  return po;
-}
-struct PostureTools {
-  explicit PostureTools(const Scenario& sc)
-      : kin(sc.robot), pg(sc.robot, sc.scene, guidePostureOptions()), checker(sc.robot, sc.scene) {}
-  Kinematics kin;
-  PostureGenerator pg;
-  ValidityChecker checker;
-};
-
-// A witness of `contacts` from `guess`, drawn toward `reference` (its joints
-// weighed 0.01 of its base's place): a posture near a chosen one. nullopt
-// when the posture generator finds none.
-std::optional<Configuration> witnessNear(PostureGenerator& pg, const std::vector<ContactSpec>& contacts,
-                                         const Configuration& guess, const Configuration& reference) {
-  PostureRequest r;
-  r.contacts = contacts;
-  r.initial_guess = guess;
-  r.cost = std::make_shared<ReferencePostureCost>(reference, 0.01, 10.0, 1.0);
-  const PostureResult res = pg.solve(r);
-  if (!res.success()) return std::nullopt;
-  return res.configuration;
-}
-
-// witnessNear, and only a witness the independent check accepts on `contacts`.
-std::optional<Configuration> checkedWitnessNear(PostureTools& t, const std::vector<ContactSpec>& contacts,
-                                                const Configuration& guess, const Configuration& reference) {
-  auto w = witnessNear(t.pg, contacts, guess, reference);
-  if (w && !t.checker.checkPosture(*w, contacts).valid()) w.reset();
-  return w;
 }
 
 // The start's contacts that are not among the goal's supports (the soles of
@@ -585,27 +560,6 @@ bool crouchOffsets(const Scenario& sc, PostureTools& t, Eigen::VectorXd& offsets
   return false;
 }
 
-// The contacts a posture makes: each allowed spot within 1 cm of an allowed
-// surface's plane, over its polygon, its frame's z within 0.3 rad of the
-// surface's outward normal (as in contact), supporting, placed where the
-// posture holds it. Each spot on one surface at most.
-std::vector<ContactSpec> contactsMadeBy(const Scenario& sc, Kinematics& kin, const Configuration& q) {
-  kin.setConfiguration(q);
-  std::vector<ContactSpec> out;
-  for (int spot : sc.allowed_spots)
-    for (int si : sc.allowed_surfaces) {
-      const Surface& surf = sc.scene->surfaces()[si];
-      if (!spotNearSurface(surf, kin.spotPose(spot))) continue;
-      ContactSpec c;
-      c.spot = spot;
-      c.surface = si;
-      c.placement = projectOnSurface(surf, kin.spotPose(spot));
-      out.push_back(c);
-      break;
-    }
-  return out;
-}
-
 // The robot's crawling posture (GuideOptions::crawling_posture) turned to
 // the start's heading, its base over `xy`, raised to the start's floor:
 // a witness of the contacts it makes there, accepted by the check. nullopt
@@ -781,16 +735,20 @@ bool gettingDown(const Scenario& sc, PostureTools& t, const Configuration& crawl
 // `max_checks` > 0 the search also stops after that many state checks: a try
 // whose failure leads to another (approach, then standing, then crouched)
 // ends on a count, not on the machine's speed, so that the same scenario and
-// seed give the same guide.
+// seed give the same guide. With GuideOptions::stable the path is sampled
+// along its edges and the samples projected into the statically stable
+// subspace (projectStable, with `tools`); a sample that does not project
+// gets a ball of the reduced space around it left out, and the leg is
+// planned again (at most stable_replans times, within the same budget).
 // False with out.status and out.reason set when there is no path.
 struct LegEnds {
   const Configuration& from;
   const Configuration& to;
   std::string from_what, to_what;  // "start posture", "approach posture", "goal posture"
 };
-bool planLeg(const Scenario& sc, const GuideOptions& o, const LegEnds& ends, double budget, long max_checks,
-             const Eigen::VectorXd& crouch, double crouch_drop, const std::atomic<bool>* cancel, GuideResult& out,
-             std::vector<Configuration>& postures) {
+bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, const LegEnds& ends, double budget,
+             long max_checks, const Eigen::VectorXd& crouch, double crouch_drop, const std::atomic<bool>* cancel,
+             GuideResult& out, std::vector<Configuration>& postures) {
   const Configuration& from = ends.from;
   const Configuration& to = ends.to;
   const std::string& what = ends.to_what;
@@ -858,34 +816,93 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, const LegEnds& ends, dou
   ss.setPlanner(planner);
   ss.setup();
   const double t1 = now();
-  const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition([&] {
+  const auto stop = [&] {
     return now() - t1 > budget || (max_checks > 0 && validity->checks() >= max_checks) || (cancel && cancel->load());
-  }));
-  out.path_seconds += now() - t1;
-  if (cancel && cancel->load()) {
-    out.status = GuideResult::Status::Cancelled;
-    out.reason = "cancelled";
-    return false;
+  };
+  std::string unprojected;  // why the last path left the statically stable subspace (GuideOptions::stable)
+  for (int attempt = 0;; ++attempt) {
+    const double t2 = now();
+    const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition(stop));
+    out.path_seconds += now() - t2;
+    if (cancel && cancel->load()) {
+      out.status = GuideResult::Status::Cancelled;
+      out.reason = "cancelled";
+      return false;
+    }
+    if (st != ob::PlannerStatus::EXACT_SOLUTION) {
+      out.status = GuideResult::Status::NoPath;
+      out.reason = "OMPL (RRTConnect) found no path to the " + what +
+                   (max_checks > 0 && validity->checks() >= max_checks ? fmt(" within %.0f state checks", max_checks)
+                                                                        : fmt(" within %.1f s", budget));
+      if (attempt > 0)
+        out.reason += fmt(" through the statically stable subspace (%.0f replans around samples that did not project; "
+                          "the last: ", attempt) + unprojected + ")";
+      return false;
+    }
+    og::PathGeometric path = ss.getSolutionPath();
+    out.path_vertices += static_cast<int>(path.getStateCount());
+    SeededSimplifier simplifier(si, seed);
+    simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+    simplifier.shortcutPath(path, static_cast<unsigned>(o.shortcut_steps));
+    simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+    // The vertices, or with GuideOptions::stable (or sample_edges) samples along the edges:
+    // at most stable_step of base travel, 0.2 rad of heading, 0.1 of blend
+    // or crouch apart.
+    std::vector<std::vector<double>> states;
+    for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+      const double* v = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
+      std::vector<double> b(v, v + dims);
+      if ((o.stable || o.sample_edges) && !states.empty()) {
+        const std::vector<double> a = states.back();
+        const double travel = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                                        (b[2] - a[2]) * (b[2] - a[2]));
+        double parts = std::max(travel / o.stable_step, std::abs(b[3] - a[3]) / 0.2);
+        for (unsigned k = 4; k < dims; ++k) parts = std::max(parts, std::abs(b[k] - a[k]) / 0.1);
+        const int n = std::max(1, static_cast<int>(std::ceil(parts - 1e-9)));
+        for (int j = 1; j < n; ++j) {
+          std::vector<double> m(dims);
+          for (unsigned k = 0; k < dims; ++k) m[k] = a[k] + (b[k] - a[k]) * j / n;
+          states.push_back(m);
+        }
+      }
+      states.push_back(b);
+    }
+    postures.clear();
+    for (std::size_t i = 0; i < states.size(); ++i)
+      postures.push_back(i == 0 ? from : (i + 1 == states.size() ? to : lift(states[i].data())));
+    if (!o.stable) return true;
+    const double t3 = now();
+    const StableProjection p = projectStable(sc, tools, postures, StableOptions{o.stable_reach, 0.5, o.stable_tolerance}, cancel);
+    out.stable_seconds += now() - t3;
+    out.stable_projections += p.projections;
+    if (p.success()) {
+      postures = p.postures;
+      return true;
+    }
+    if (cancel && cancel->load()) {
+      out.status = GuideResult::Status::Cancelled;
+      out.reason = "cancelled";
+      return false;
+    }
+    unprojected = p.reason;
+    if (attempt >= o.stable_replans || stop()) {
+      out.status = GuideResult::Status::NoPath;
+      out.reason = "no path to the " + what + " through the statically stable subspace: " + p.reason +
+                   fmt(" (after %.0f replans)", attempt);
+      return false;
+    }
+    // Planned again with a ball around that sample left out (smaller than
+    // its distance to either end, which stay valid).
+    const std::vector<double>& c = states[static_cast<std::size_t>(p.failed_sample)];
+    auto dist = [&](const double* e) {
+      double d2 = 0;
+      for (unsigned k = 0; k < dims; ++k) d2 += (c[k] - e[k]) * (c[k] - e[k]);
+      return std::sqrt(d2);
+    };
+    validity->forbid(c, std::min({o.stable_forbid, 0.9 * dist(sv), 0.9 * dist(gv)}));
+    ++out.stable_replans;
+    ss.clear();
   }
-  if (st != ob::PlannerStatus::EXACT_SOLUTION) {
-    out.status = GuideResult::Status::NoPath;
-    out.reason = "OMPL (RRTConnect) found no path to the " + what +
-                 (max_checks > 0 && validity->checks() >= max_checks ? fmt(" within %.0f state checks", max_checks)
-                                                                      : fmt(" within %.1f s", budget));
-    return false;
-  }
-  og::PathGeometric path = ss.getSolutionPath();
-  out.path_vertices += static_cast<int>(path.getStateCount());
-  SeededSimplifier simplifier(si, seed);
-  simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
-  simplifier.shortcutPath(path, static_cast<unsigned>(o.shortcut_steps));
-  simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
-  postures.clear();
-  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
-    const double* v = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
-    postures.push_back(i == 0 ? from : (i + 1 == path.getStateCount() ? to : lift(v)));
-  }
-  return true;
 }
 
 // Appends a leg's postures to the guide, leaving out a posture whose base is
@@ -922,7 +939,7 @@ GuideResult crawlGuide(const Scenario& sc, const GuideOptions& o, PostureTools& 
   if (const auto crawling = crawlingAt(sc, o, t, floor, ahead, contacts)) down.push_back(*crawling);
   const LegEnds ends{down.back(), goal, "crawling posture where the robot got down", "crawling goal posture"};
   std::vector<Configuration> leg;
-  if (!planLeg(sc, o, ends, o.max_seconds, 0, {}, 0, cancel, out, leg)) return out;
+  if (!planLeg(sc, o, t, ends, o.max_seconds, 0, {}, 0, cancel, out, leg)) return out;
   Guide& g = out.guide;
   g.source = "ompl";
   g.scenario = sc.path;
@@ -930,7 +947,7 @@ GuideResult crawlGuide(const Scenario& sc, const GuideOptions& o, PostureTools& 
   out.crawl_index = static_cast<int>(g.key_postures.size()) - 1;
   appendKeys(g, leg);
   g.seconds = now() - t0;
-  out.goal_seconds = g.seconds - out.path_seconds;
+  out.goal_seconds = g.seconds - out.path_seconds - out.stable_seconds;
   out.status = GuideResult::Status::Success;
   out.reason.clear();
   return out;
@@ -977,8 +994,8 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     const LegEnds first{sc.start, approach, "start posture", "approach posture"};
     const LegEnds second{approach, goal, "approach posture", "goal posture from the approach posture"};
     std::vector<Configuration> to_approach;
-    if (planLeg(sc, o, first, remaining(), o.fallback_checks, {}, 0, cancel, out, to_approach) &&
-        planLeg(sc, o, second, remaining(), o.fallback_checks, {}, 0, cancel, out, leg)) {
+    if (planLeg(sc, o, tools, first, remaining(), o.fallback_checks, {}, 0, cancel, out, to_approach) &&
+        planLeg(sc, o, tools, second, remaining(), o.fallback_checks, {}, 0, cancel, out, leg)) {
       approach_index = static_cast<int>(to_approach.size()) - 1;
       legs = {to_approach, leg};
       out.approach = true;
@@ -988,7 +1005,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
   // Straight to the goal posture; where no path comes, with a crouch (under
   // a low beam: a blend of two standing postures cannot lower the head).
   if (legs.empty()) {
-    if (planLeg(sc, o, straight, remaining(), o.crouch ? o.fallback_checks : 0, {}, 0, cancel, out, leg))
+    if (planLeg(sc, o, tools, straight, remaining(), o.crouch ? o.fallback_checks : 0, {}, 0, cancel, out, leg))
       legs.push_back(leg);
     else if (out.status != GuideResult::Status::NoPath) return out;
   }
@@ -1004,7 +1021,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
       out.reason = standing_failure + "; the start stance has no valid crouch to try";
       return out;
     }
-    if (!planLeg(sc, o, straight, remaining(), 0, crouch, drop, cancel, out, leg)) {
+    if (!planLeg(sc, o, tools, straight, remaining(), 0, crouch, drop, cancel, out, leg)) {
       if (out.status == GuideResult::Status::NoPath)
         out.reason = standing_failure + fmt(", nor with a crouch of %.2f m", drop);
       return out;
@@ -1026,7 +1043,7 @@ GuideResult authorGuide(const Scenario& sc, const GuideOptions& o, const std::at
     return out;
   }
   g.seconds = now() - t0;
-  out.goal_seconds = g.seconds - out.path_seconds;  // the goal, approach and crouch postures
+  out.goal_seconds = g.seconds - out.path_seconds - out.stable_seconds;  // the goal, approach and crouch postures
   out.status = GuideResult::Status::Success;
   out.reason.clear();  // an approach or standing leg that failed on the way said why; the guide was made
   return out;

@@ -48,6 +48,22 @@ struct GuideOptions {
   bool crawl = true;
   std::string crawling_posture = "crawling";
   double crawl_step = 0.1;      // m: the crawling posture this far ahead of where the robot got down
+  // Paths through the statically stable subspace (Bouyarmane 2009;
+  // planner/guide/stable_path.h): every leg's shortcut path sampled along its
+  // edges, each sample projected by the posture generator onto a posture in
+  // static equilibrium on the contacts it makes, accepted by the check; the
+  // key postures are the projections. Where a sample does not project, the
+  // leg is planned again with a ball around it left out of the reduced
+  // space, at most stable_replans times.
+  bool stable = false;
+  // The key postures samples along the edges as with `stable`, not
+  // projected (a control for what the projection itself changes).
+  bool sample_edges = false;
+  double stable_step = 0.1;     // m of base travel (and 0.1 of blend, 0.2 rad of heading) between samples
+  double stable_reach = 0.05;   // m: a spot this close to an allowed surface rests on it (StableOptions::reach)
+  double stable_tolerance = 0.1;  // m: a projection's base this near the sample's, horizontally
+  int stable_replans = 4;
+  double stable_forbid = 0.1;   // the left-out ball's radius in the reduced space's metric
   unsigned seed = 1;
 };
 
@@ -62,6 +78,9 @@ struct GuideResult {
   bool crouch = false;          // the path needed the crouch coordinate (crouchOffsets)
   bool crawl = false;           // the goal is crawling: the guide gets down first (gettingDown)
   int crawl_index = -1;         // the key posture at which the robot is down on its crawl contacts
+  int stable_projections = 0;   // posture generator calls projecting samples (GuideOptions::stable)
+  int stable_replans = 0;       // legs planned again around a sample that did not project
+  double stable_seconds = 0;    // spent projecting
   double goal_seconds = 0, path_seconds = 0;
   bool success() const { return status == Status::Success; }
 };
