@@ -79,7 +79,8 @@ StableProjection projectStable(const Scenario& sc, PostureTools& t, const std::v
       out.reason = fmt("no statically stable posture near the rough path at base (%.2f, %.2f, %.2f)", q.base_position.x(),
                        q.base_position.y(), q.base_position.z()) +
                    ", sample " + std::to_string(i) + " of " + std::to_string(samples.size() - 1) +
-                   fmt(" (none within %.2f m of it horizontally; tried its own contacts within ", o.tolerance) + fmt("%.2f m: ", o.reach) + names(sc, own) +
+                   fmt(" (none within %.2f m of it horizontally; ", o.tolerance) +
+                   fmt("tried its own contacts within %.2f m: ", o.reach) + names(sc, own) +
                    "; the stance before it: " + names(sc, stance) + ")";
       return out;
     }
