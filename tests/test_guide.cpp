@@ -366,7 +366,9 @@ TEST(GuideAuthor, AStableGuideRestsEveryKeyPostureOnTheSceneInEquilibrium) {
   EXPECT_GT(k.size(), plain.guide.key_postures.size()) << "sampled along the edges, not only at the vertices";
   for (std::size_t i = 0; i < k.size(); ++i) {
     EXPECT_TRUE(inEquilibrium(k[i])) << "key posture " << i << " at " << k[i].base_position.transpose();
-    if (i > 0) EXPECT_LT((k[i].base_position - k[i - 1].base_position).head<2>().norm(), 0.25) << i;
+    if (i > 0) {
+      EXPECT_LT((k[i].base_position - k[i - 1].base_position).head<2>().norm(), 0.25) << i;
+    }
   }
   EXPECT_EQ(k.front().joints, sc.start.joints);
   kin.setConfiguration(k.back());
@@ -402,7 +404,8 @@ TEST(GuideAuthor, AGapNoStanceSpansHasNoPathThroughTheStableSubspaceAndSaysWhere
   std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
   const auto s = text.find("scene: ");
   text.replace(s, text.find('\n', s) - s, "scene: " + dir.path() + "/gap_floor.yaml");
-  for (const char* c : {"surface: floor}", "surface: floor}"}) text.replace(text.find(c), 15, "surface: floor_near}");
+  for (auto at = text.find("surface: floor}"); at != std::string::npos; at = text.find("surface: floor}", at))
+    text.replace(at, 15, "surface: floor_near}");
   text.replace(text.find("allowed_surfaces: [floor]"), 25, "allowed_surfaces: [floor_near, floor_far]");
   text.replace(text.find("min: 0.25"), 9, "min: 1.60");
   text.erase(text.find("key_postures:"));

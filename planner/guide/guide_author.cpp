@@ -107,7 +107,7 @@ class RelaxedValidity : public ob::StateValidityChecker {
   void setCeiling(double above_ground) { ceiling_ = above_ground; }
   // A ball of the reduced space left out (around a sample that did not
   // project into the statically stable subspace).
-  void forbid(std::vector<double> centre, double radius) { forbidden_.push_back({std::move(centre), radius}); }
+  void forbid(Eigen::VectorXd centre, double radius) { forbidden_.push_back({std::move(centre), radius}); }
   const long& checks() const { return checks_; }  // states checked so far
   // The base's height above the ground within a step of it (the highest
   // under its point and the corners and edge middles of a square 2 kStep
@@ -126,11 +126,8 @@ class RelaxedValidity : public ob::StateValidityChecker {
   bool isValid(const ob::State* state) const override {
     ++checks_;
     const double* s = state->as<ob::RealVectorStateSpace::StateType>()->values;
-    for (const auto& [centre, radius] : forbidden_) {
-      double d2 = 0;
-      for (std::size_t k = 0; k < centre.size(); ++k) d2 += (s[k] - centre[k]) * (s[k] - centre[k]);
-      if (d2 < radius * radius) return false;
-    }
+    for (const auto& [centre, radius] : forbidden_)
+      if ((Eigen::Map<const Eigen::VectorXd>(s, centre.size()) - centre).norm() < radius) return false;
     if (ceiling_) {
       const auto h = heightAboveGround(s);
       if (h && *h > *ceiling_) return false;
@@ -151,7 +148,7 @@ class RelaxedValidity : public ob::StateValidityChecker {
   CollisionModel collision_;
   double penetration_;
   std::optional<double> ceiling_;
-  std::vector<std::pair<std::vector<double>, double>> forbidden_;
+  std::vector<std::pair<Eigen::VectorXd, double>> forbidden_;
   mutable long checks_ = 0;
 };
 
@@ -819,16 +816,18 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
   const auto stop = [&] {
     return now() - t1 > budget || (max_checks > 0 && validity->checks() >= max_checks) || (cancel && cancel->load());
   };
+  const auto cancelled = [&] {
+    if (!cancel || !cancel->load()) return false;
+    out.status = GuideResult::Status::Cancelled;
+    out.reason = "cancelled";
+    return true;
+  };
   std::string unprojected;  // why the last path left the statically stable subspace (GuideOptions::stable)
   for (int attempt = 0;; ++attempt) {
     const double t2 = now();
     const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition(stop));
     out.path_seconds += now() - t2;
-    if (cancel && cancel->load()) {
-      out.status = GuideResult::Status::Cancelled;
-      out.reason = "cancelled";
-      return false;
-    }
+    if (cancelled()) return false;
     if (st != ob::PlannerStatus::EXACT_SOLUTION) {
       out.status = GuideResult::Status::NoPath;
       out.reason = "OMPL (RRTConnect) found no path to the " + what +
@@ -848,22 +847,17 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     // The vertices, or with GuideOptions::stable (or sample_edges) samples along the edges:
     // at most stable_step of base travel, 0.2 rad of heading, 0.1 of blend
     // or crouch apart.
-    std::vector<std::vector<double>> states;
+    std::vector<Eigen::VectorXd> states;
     for (std::size_t i = 0; i < path.getStateCount(); ++i) {
-      const double* v = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
-      std::vector<double> b(v, v + dims);
+      const Eigen::VectorXd b =
+          Eigen::Map<const Eigen::VectorXd>(path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values, dims);
       if ((o.stable || o.sample_edges) && !states.empty()) {
-        const std::vector<double> a = states.back();
-        const double travel = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
-                                        (b[2] - a[2]) * (b[2] - a[2]));
-        double parts = std::max(travel / o.stable_step, std::abs(b[3] - a[3]) / 0.2);
-        for (unsigned k = 4; k < dims; ++k) parts = std::max(parts, std::abs(b[k] - a[k]) / 0.1);
+        const Eigen::VectorXd a = states.back();
+        const Eigen::VectorXd d = b - a;
+        double parts = std::max(d.head<3>().norm() / o.stable_step, std::abs(d[3]) / 0.2);
+        if (dims > 4) parts = std::max(parts, d.tail(dims - 4).cwiseAbs().maxCoeff() / 0.1);
         const int n = std::max(1, static_cast<int>(std::ceil(parts - 1e-9)));
-        for (int j = 1; j < n; ++j) {
-          std::vector<double> m(dims);
-          for (unsigned k = 0; k < dims; ++k) m[k] = a[k] + (b[k] - a[k]) * j / n;
-          states.push_back(m);
-        }
+        for (int j = 1; j < n; ++j) states.push_back(a + d * static_cast<double>(j) / n);
       }
       states.push_back(b);
     }
@@ -872,18 +866,17 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
       postures.push_back(i == 0 ? from : (i + 1 == states.size() ? to : lift(states[i].data())));
     if (!o.stable) return true;
     const double t3 = now();
-    const StableProjection p = projectStable(sc, tools, postures, StableOptions{o.stable_reach, 0.5, o.stable_tolerance}, cancel);
+    StableOptions so;
+    so.reach = o.stable_reach;
+    so.tolerance = o.stable_tolerance;
+    const StableProjection p = projectStable(sc, tools, postures, so, cancel);
     out.stable_seconds += now() - t3;
     out.stable_projections += p.projections;
     if (p.success()) {
       postures = p.postures;
       return true;
     }
-    if (cancel && cancel->load()) {
-      out.status = GuideResult::Status::Cancelled;
-      out.reason = "cancelled";
-      return false;
-    }
+    if (cancelled()) return false;
     unprojected = p.reason;
     if (attempt >= o.stable_replans || stop()) {
       out.status = GuideResult::Status::NoPath;
@@ -893,13 +886,9 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     }
     // Planned again with a ball around that sample left out (smaller than
     // its distance to either end, which stay valid).
-    const std::vector<double>& c = states[static_cast<std::size_t>(p.failed_sample)];
-    auto dist = [&](const double* e) {
-      double d2 = 0;
-      for (unsigned k = 0; k < dims; ++k) d2 += (c[k] - e[k]) * (c[k] - e[k]);
-      return std::sqrt(d2);
-    };
-    validity->forbid(c, std::min({o.stable_forbid, 0.9 * dist(sv), 0.9 * dist(gv)}));
+    const Eigen::VectorXd& c = states[static_cast<std::size_t>(p.failed_sample)];
+    const double to_ends = std::min((c - states.front()).norm(), (c - states.back()).norm());
+    validity->forbid(c, std::min(o.stable_forbid, 0.9 * to_ends));
     ++out.stable_replans;
     ss.clear();
   }
