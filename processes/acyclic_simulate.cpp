@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "hrp2_bridge/sim/dynamics_simulation.h"
+#include "hrp2_bridge/stabilizer_schedule.h"
 #include "hrp2_bridge/trajectory_file.h"
 #include "processes/command_line.h"
 
@@ -46,7 +47,7 @@ int main(int argc, char** argv) {
   std::string trace_path;
   app.add_option("--trace", trace_path,
                  "write one CSV row per controller period: time, phase, stabilizer flag, centre of mass and base "
-                 "(simulated and planned, world, m), tilt (rad), each spot's vertical force (world z, N)");
+                 "(simulated and planned, world, m), tilt (rad) and as a world rotation vector (its x, y the lean, its z the yaw), each spot's vertical force (world z, N)");
   bool open_loop = false;
   app.add_flag("--no-stabilizer", open_loop,
                "play every phase open-loop: no model of HRP-2's stabilizer, even where the bridge runs it (only coplanar feet touch)");
@@ -90,15 +91,22 @@ int main(int argc, char** argv) {
         return 2;
       }
       std::fprintf(trace_file.get(), "t,phase,stabilizer,com_x,com_y,com_z,plan_com_x,plan_com_y,plan_com_z,"
-                                     "base_x,base_y,base_z,plan_base_x,plan_base_y,plan_base_z,tilt");
+                                     "base_x,base_y,base_z,plan_base_x,plan_base_y,plan_base_z,tilt,tilt_x,tilt_y,tilt_z");
       for (const auto& s : sc.robot->spots()) std::fprintf(trace_file.get(), ",%s_fz", s.name.c_str());
+      std::fprintf(trace_file.get(), ",zmp_x,zmp_y,wanted_zmp_x,wanted_zmp_y");
+      for (int s = 0; s < static_cast<int>(sc.robot->spots().size()); ++s)
+        if (hrp2::isFootSpot(*sc.robot, s))
+          std::fprintf(trace_file.get(), ",%s_turn_x,%s_turn_y", sc.robot->spots()[s].name.c_str(),
+                       sc.robot->spots()[s].name.c_str());
       std::fprintf(trace_file.get(), "\n");
       trace = [f = trace_file.get()](const hrp2::SimulationSample& s) {
         std::fprintf(f, "%.3f,%d,%d", s.t, s.phase, s.stabilizer_on ? 1 : 0);
         for (const Eigen::Vector3d* v : {&s.com, &s.plan_com, &s.base, &s.plan_base})
           std::fprintf(f, ",%.5f,%.5f,%.5f", v->x(), v->y(), v->z());
-        std::fprintf(f, ",%.5f", s.tilt);
+        std::fprintf(f, ",%.5f,%.5f,%.5f,%.5f", s.tilt, s.tilt_vector.x(), s.tilt_vector.y(), s.tilt_vector.z());
         for (const auto& fs : s.spot_forces) std::fprintf(f, ",%.1f", fs.z());
+        std::fprintf(f, ",%.5f,%.5f,%.5f,%.5f", s.zmp.x(), s.zmp.y(), s.wanted_zmp.x(), s.wanted_zmp.y());
+        for (const Eigen::Vector2d& a : s.foot_tilts) std::fprintf(f, ",%.5f,%.5f", a.x(), a.y());
         std::fprintf(f, "\n");
       };
     }

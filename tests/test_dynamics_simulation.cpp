@@ -280,7 +280,8 @@ TEST(SimulateProcess, HelpBadInputAndAFall) {
   EXPECT_EQ(traced.status, 1) << traced.output;
   const std::string csv = test::readFile(dir.path() + "/t.csv");
   EXPECT_EQ(csv.rfind("t,phase,stabilizer,com_x", 0), 0u) << csv.substr(0, 200);
-  EXPECT_NE(csv.find(",l_palm_fz\n"), std::string::npos);
+  EXPECT_NE(csv.find(",l_palm_fz,zmp_x,zmp_y,wanted_zmp_x,wanted_zmp_y,r_sole_turn_x"), std::string::npos);
+  EXPECT_NE(csv.find(",l_sole_turn_y\n"), std::string::npos);
   const long rows = std::count(csv.begin(), csv.end(), '\n') - 1;
   EXPECT_GT(rows, 100);
   EXPECT_LT(rows, 800);  // 4 s at most: stopped at the fall

@@ -575,7 +575,18 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
       ts.base = q.base_position;
       ts.plan_base = to.q.base_position;
       ts.tilt = tilt;
+      const Eigen::AngleAxisd err(q.base_orientation * to.q.base_orientation.inverse());
+      ts.tilt_vector = err.angle() * err.axis();
       ts.spot_forces = f;
+      Eigen::Vector3d F = Eigen::Vector3d::Zero(), M = Eigen::Vector3d::Zero();
+      for (int s = 0; s < static_cast<int>(wrenches.size()); ++s) {
+        F += wrenches[s].force;
+        M += wrenches[s].moment + S.spotPose(s).translation().cross(wrenches[s].force);
+      }
+      if (F.z() > 1.0) ts.zmp = Eigen::Vector2d(-M.y() / F.z(), M.x() / F.z());
+      if (stabilizer && stabilizer_on[std::min(k, N - 1)]) ts.wanted_zmp = stabilizer->wantedZmp();
+      for (int s = 0; s < static_cast<int>(m.spots().size()); ++s)
+        if (isFootSpot(m, s)) ts.foot_tilts.push_back(stabilizer ? stabilizer->tilt(s) : Eigen::Vector2d::Zero());
       trace(ts);
     }
     // A fall: the base far below the plan or tilted far from it.

@@ -11,6 +11,7 @@
 // streams references and advances time (DynamicsSimulator).
 //
 // Simbody is hidden behind this header (docs/design.md section 4).
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -130,7 +131,17 @@ struct SimulationSample {
   Eigen::Vector3d com = Eigen::Vector3d::Zero(), plan_com = Eigen::Vector3d::Zero();   // world
   Eigen::Vector3d base = Eigen::Vector3d::Zero(), plan_base = Eigen::Vector3d::Zero(); // world
   double tilt = 0;                   // rad, base orientation against the plan
+  // The same as a rotation vector in the world (simulated times the plan's
+  // inverse): its x and y are the lean, its z the yaw.
+  Eigen::Vector3d tilt_vector = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> spot_forces;   // world, per robot spot
+  // The zero-moment point of every contact wrench on the plane z = 0 (world
+  // x-y; NaN without load), and the stabilizer's wanted one (NaN when it is
+  // off or not modelled).
+  Eigen::Vector2d zmp = Eigen::Vector2d::Constant(NAN), wanted_zmp = Eigen::Vector2d::Constant(NAN);
+  // Each sole's turn by the stabilizer about its own x and y, rad (robot
+  // spots order, soles only: hrp2::isFootSpot).
+  std::vector<Eigen::Vector2d> foot_tilts;
 };
 using SimulationTrace = std::function<void(const SimulationSample&)>;
 
