@@ -47,7 +47,9 @@ int main(int argc, char** argv) {
   std::string trace_path;
   app.add_option("--trace", trace_path,
                  "write one CSV row per controller period: time, phase, stabilizer flag, centre of mass and base "
-                 "(simulated and planned, world, m), tilt (rad) and as a world rotation vector (its x, y the lean, its z the yaw), each spot's vertical force (world z, N)");
+                 "(simulated and planned, world, m), tilt (rad) and as a world rotation vector (its x, y the lean, its z the yaw), "
+                 "each spot's vertical force (world z, N), the contact wrenches' ZMP and the stabilizer's wanted one "
+                 "(world x-y, m; nan without load or stabilizer), each sole's turn by the stabilizer (rad)");
   bool open_loop = false;
   app.add_flag("--no-stabilizer", open_loop,
                "play every phase open-loop: no model of HRP-2's stabilizer, even where the bridge runs it (only coplanar feet touch)");
