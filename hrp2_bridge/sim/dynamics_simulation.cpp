@@ -345,7 +345,10 @@ struct DynamicsSimulator::Impl {
     system.realize(st, SimTK::Stage::Dynamics);
     std::vector<SpotWrench> out(robot->spots().size());
     std::vector<Eigen::Vector3d> origin(robot->spots().size());
-    for (std::size_t s = 0; s < origin.size(); ++s) origin[s] = spotPose(static_cast<int>(s)).translation();
+    for (std::size_t s = 0; s < origin.size(); ++s) {
+      out[s].frame = spotPose(static_cast<int>(s));
+      origin[s] = out[s].frame->translation();
+    }
     const SimTK::ContactSnapshot& snap = tracker.getActiveContacts(st);
     for (int i = 0; i < contact.getNumContactForces(st); ++i) {
       const SimTK::ContactForce& f = contact.getContactForce(st, i);
@@ -495,7 +498,7 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
     if (stabilizer) {
       const bool on = stabilizer_on[std::min(k, N - 1)];
       offset_from = offset_to;
-      offset_to = stabilizer->update(dt, on, to.q, tr.phases[to.phase].contacts, com, wrenches);
+      offset_to = stabilizer->update(dt, on, to.q, tr.phases[to.phase].contacts, com, wrenches, sim.configuration().basePose());
       if (on && k < N) rep.stabilizer_on_time += dt;
       for (int s = 0; s < static_cast<int>(m.spots().size()); ++s) {
         rep.stabilizer_max_tilt = std::max(rep.stabilizer_max_tilt, stabilizer->tilt(s).norm());

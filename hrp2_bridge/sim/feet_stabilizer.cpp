@@ -31,6 +31,10 @@ void FeetStabilizerOptions::validate() const {
   nonNegative(max_lift, "max_lift");
   nonNegative(cop_edge, "cop_edge");
   positive(off_time, "off_time");
+  positive(place_time, "place_time");
+  nonNegative(max_place, "max_place");
+  nonNegative(max_place_turn, "max_place_turn");
+  positive(place_leak, "place_leak");
 }
 
 FeetStabilizer::FeetStabilizer(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,
@@ -40,6 +44,7 @@ FeetStabilizer::FeetStabilizer(std::shared_ptr<const RobotModel> robot, std::sha
   const RobotModel& m = *robot_;
   lift_.assign(m.spots().size(), 0.0);
   tilt_.assign(m.spots().size(), Eigen::Vector2d::Zero());
+  place_.assign(m.spots().size(), Eigen::Matrix<double, 6, 1>::Zero());
   want_load_.assign(m.spots().size(), 0.0);
   want_cop_.assign(m.spots().size(), Eigen::Vector2d::Zero());
   for (int s = 0; s < static_cast<int>(m.spots().size()); ++s) {
@@ -126,7 +131,8 @@ std::vector<double> spreadWeights(const std::vector<Eigen::Vector2d>& p, Eigen::
 
 Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& plan,
                                        const std::vector<ContactSpec>& contacts, const Eigen::Vector3d& com,
-                                       const std::vector<SpotWrench>& wrenches) {
+                                       const std::vector<SpotWrench>& wrenches,
+                                       const std::optional<Eigen::Isometry3d>& waist) {
   const RobotModel& m = *robot_;
   kin_.setConfiguration(plan);
   const Eigen::Vector3d plan_com = kin_.centerOfMass();
@@ -149,6 +155,9 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
     double force = 0;         // measured, along the normal
     double want = 0;
     Eigen::Vector2d cop = Eigen::Vector2d::Zero(), want_cop = Eigen::Vector2d::Zero();  // spot frame
+    // Where the wanted centre of pressure was pulled from to keep it cop_edge
+    // inside the sole (zero when it was not pulled), spot frame.
+    Eigen::Vector2d pulled = Eigen::Vector2d::Zero();
   };
   std::vector<Foot> down;
   for (const ContactSpec& c : contacts)
@@ -157,7 +166,16 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
   std::vector<bool> regulated(m.spots().size(), false);
   std::fill(want_load_.begin(), want_load_.end(), 0.0);
   if (on && !down.empty()) {
-    zmp_ = plan_com.head<2>() + opt_.zmp_com_gain * (com - plan_com).head<2>() +
+    // The supporting soles' mean offset from their planned places.
+    Eigen::Vector2d drift = Eigen::Vector2d::Zero();
+    int measured = 0;
+    for (const Foot& f : down)
+      if (f.supporting && wrenches[f.spot].frame) {
+        drift += (wrenches[f.spot].frame->translation() - f.pose.translation()).head<2>();
+        ++measured;
+      }
+    if (measured > 0) drift /= measured;
+    zmp_ = plan_com.head<2>() + opt_.zmp_com_gain * (com.head<2>() - drift - plan_com.head<2>()) +
            opt_.zmp_velocity_gain * com_velocity_.head<2>();
     double total = 0;
     for (Foot& f : down) {
@@ -177,6 +195,7 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
       f.want = share * total;
       const Eigen::Vector3d local = f.pose.inverse() * Eigen::Vector3d(p.x(), p.y(), f.pose.translation().z());
       f.want_cop = nearestIn(m.spots()[f.spot].polygon.inset(opt_.cop_edge), local.head<2>());
+      f.pulled = local.head<2>() - f.want_cop;
     };
     if (sup.size() == 1) {
       wantAt(*sup[0], 1.0, zmp_);
@@ -197,12 +216,15 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
       }
       const std::vector<double> w = spreadWeights(corners, zmp_);
       if (!w.empty()) {
+        // How far the wanted ZMP was pulled into the shrunk soles' hull.
+        const Eigen::Vector2d pulled = zmp_ - nearestIn(ConvexPolygon(hull(corners)), zmp_);
         for (std::size_t k = 0; k < sup.size(); ++k) {
           double share = 0;
           Eigen::Vector2d at = Eigen::Vector2d::Zero();
           for (std::size_t i = 0; i < corners.size(); ++i)
             if (owner[i] == static_cast<int>(k)) share += w[i], at += w[i] * corners[i];
           wantAt(*sup[k], share, share > 1e-9 ? Eigen::Vector2d(at / share) : sup[k]->pose.translation().head<2>());
+          sup[k]->pulled += (sup[k]->pose.linear().transpose() * Eigen::Vector3d(pulled.x(), pulled.y(), 0)).head<2>();
         }
       } else {
         const Eigen::Vector2d a = sup[0]->pose.translation().head<2>(), b = sup[1]->pose.translation().head<2>();
@@ -225,18 +247,69 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
       if (f.supporting && f.force > 1.0) {
         // Turning about the foot's +y by a > 0 presses its toe (+x) down;
         // about its +x by b > 0 lifts its +y side.
-        const Eigen::Vector2d e = f.want_cop - f.cop;
+        Eigen::Vector2d e = f.want_cop - f.cop;
+        // A ZMP wanted beyond the sole's edge was pulled cop_edge inside it;
+        // a centre of pressure already past that point, toward the wanted
+        // ZMP, is where the stabilizer wants it: turning the foot to bring it
+        // back inside would move the centre of mass away from the ZMP's side,
+        // the opposite of what the wanted ZMP asks.
+        if (f.pulled.norm() > 1e-9) {
+          const Eigen::Vector2d u = f.pulled.normalized();
+          if (e.dot(u) < 0) e -= e.dot(u) * u;
+        }
         th.x() = step(th.x(), -opt_.cop_gain * e.y() - th.x() / opt_.cop_leak, dt, opt_.max_tilt);
         th.y() = step(th.y(), opt_.cop_gain * e.x() - th.y() / opt_.cop_leak, dt, opt_.max_tilt);
       } else {
         th *= std::exp(-dt / opt_.cop_leak);
       }
+      for (int i = 0; i < 6; ++i) place_[f.spot][i] *= std::exp(-dt / opt_.place_leak);
       regulated[f.spot] = true;
     }
   }
+  // The supporting sole a swinging one is placed against: the first
+  // supporting sole of the phase whose frame is measured.
+  const Foot* anchor = nullptr;
+  if (on)
+    for (const Foot& f : down)
+      if (f.supporting && wrenches[f.spot].frame) {
+        anchor = &f;
+        break;
+      }
   for (int s : feet_)
     if (!regulated[s]) {
-      lift_[s] *= std::exp(-dt / opt_.off_time);
+      const double f = kin_.spotPose(s).linear().col(2).dot(wrenches[s].force);
+      if (anchor && waist && f > 1.0) {
+        // Touching the floor already: held where it is.
+      } else if (anchor && waist) {
+        // Where the plan has this sole relative to the anchor, put on the
+        // anchor's measured frame, against where the reference puts it: the
+        // plan's sole relative to the waist, on the measured waist. (Not
+        // against the measured sole, whose lag behind a moving reference is
+        // no placement error.)
+        const Eigen::Isometry3d want = *wrenches[anchor->spot].frame * anchor->pose.inverse() * kin_.spotPose(s);
+        const Eigen::Isometry3d ref = *waist * plan.basePose().inverse() * kin_.spotPose(s);
+        // Along the floor only: across the floor the sole's height and
+        // tilt stay the plan's (pushing a sole down against a waist that the
+        // push itself tilts would feed on itself; a sole that lands early
+        // yields instead, below).
+        const Eigen::AngleAxisd turn(want.linear() * ref.linear().transpose());
+        Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();
+        target.head<2>() = (want.translation() - ref.translation()).head<2>();
+        target[5] = (turn.angle() * turn.axis()).z();
+        Eigen::Matrix<double, 6, 1>& x = place_[s];
+        for (int i = 0; i < 6; ++i) {
+          const double bound = i < 3 ? opt_.max_place : opt_.max_place_turn;
+          x[i] = step(x[i], (std::clamp(target[i], -bound, bound) - x[i]) / opt_.place_time, dt, bound);
+        }
+      } else {
+        for (int i = 0; i < 6; ++i) place_[s][i] *= std::exp(-dt / opt_.off_time);
+      }
+      // A swinging foot that meets the floor early (the body sags a few
+      // millimetres under its servos' compliance) yields to the load it
+      // measures, as the landing foot's force control does, instead of
+      // pushing the body over with the rest of its descent.
+      if (on && f > 1.0) lift_[s] = step(lift_[s], f / opt_.force_damping, dt, opt_.max_lift);
+      else lift_[s] *= std::exp(-dt / opt_.off_time);
       tilt_[s] *= std::exp(-dt / opt_.off_time);
     }
 
@@ -246,12 +319,12 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
   Eigen::VectorXd dq = Eigen::VectorXd::Zero(m.numJoints());
   for (std::size_t k = 0; k < feet_.size(); ++k) {
     const int s = feet_[k];
-    if (std::abs(lift_[s]) < 1e-9 && tilt_[s].norm() < 1e-9) continue;
+    if (std::abs(lift_[s]) < 1e-9 && tilt_[s].norm() < 1e-9 && place_[s].norm() < 1e-9) continue;
     const ContactSpot& spot = m.spots()[s];
     const Eigen::Isometry3d pose = kin_.spotPose(s);
-    Eigen::Matrix<double, 6, 1> d;
-    d.head<3>() = lift_[s] * pose.linear().col(2);
-    d.tail<3>() = pose.linear() * Eigen::Vector3d(tilt_[s].x(), tilt_[s].y(), 0);
+    Eigen::Matrix<double, 6, 1> d = place_[s];
+    d.head<3>() += lift_[s] * pose.linear().col(2);
+    d.tail<3>() += pose.linear() * Eigen::Vector3d(tilt_[s].x(), tilt_[s].y(), 0);
     const Eigen::MatrixXd J = kin_.frameJacobian(spot.link, spot.frame.translation());
     const std::vector<int>& leg = leg_[k];
     Eigen::MatrixXd Jl(6, leg.size());
