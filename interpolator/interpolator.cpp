@@ -70,6 +70,7 @@ InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions 
   if (f.has("posture_support_inset")) o.support_inset = f["posture_support_inset"].number();
   if (f.has("posture_support_inset_y")) o.support_inset_y = f["posture_support_inset_y"].number();
   if (f.has("posture_friction_share")) o.friction_share = f["posture_friction_share"].number();
+  if (f.has("zmp_shift_cap")) o.zmp_shift_cap = f["zmp_shift_cap"].number();
   return o;
 }
 

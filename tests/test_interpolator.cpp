@@ -1128,15 +1128,17 @@ TEST(InterpolatorProcess, WritesATrajectoryThatAcyclicCheckAccepts) {
 // with (its planner section), unless the command line says otherwise: the
 // scenario's 6 cm inset gives the trajectory that --support-inset 0.06
 // gives, and moves the single supports' centre of mass away from where no
-// margin leaves it; --support-inset 0 on the command line wins.
+// margin leaves it; --support-inset 0 on the command line wins. The same for
+// the time law's ZMP shift cap.
 TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem) {
   const Scenario& sc = floorScenario();
   test::TempDir dir;
   const std::string scenario =
       dir.write("margins.yaml", test::scenarioText("models/scenarios/step_forward.yaml") +
-                                    "planner: {posture_support_inset: 0.06, posture_friction_share: 0.5}\n");
+                                    "planner: {posture_support_inset: 0.06, posture_friction_share: 0.5, zmp_shift_cap: 0.004}\n");
   const Scenario with = Scenario::load(scenario);
   const InterpolatorOptions o = withScenarioMargins(with, {});
+  EXPECT_DOUBLE_EQ(o.zmp_shift_cap, 0.004);
   EXPECT_DOUBLE_EQ(o.support_inset, 0.06);
   EXPECT_DOUBLE_EQ(o.friction_share, 0.5);
   EXPECT_DOUBLE_EQ(o.support_inset_y, -1.0);
@@ -1162,6 +1164,9 @@ TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem)
     apart = std::max(apart, (a.centerOfMass() - b.centerOfMass()).head<2>().norm());
   }
   EXPECT_GT(apart, 0.005);
+  // The scenario's ZMP shift cap slows the weight shifts; 0 on the command line lifts it.
+  const Trajectory uncapped = run("d.json", "--zmp-shift-cap 0");
+  EXPECT_GT(by_scenario.duration(), uncapped.duration() + 0.1);
 }
 
 TEST(InterpolatorProcess, HelpAndBadInput) {

@@ -355,6 +355,7 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {posture_distance_engine: bullet}\n", "planner.posture_distance_engine"},
            {"planner: {posture_pyramid_edges: 6}\n", "planner.posture_pyramid_edges"},
            {"planner: {posture_support_inset: -0.01}\n", "planner.posture_support_inset"},
+           {"planner: {zmp_shift_cap: 0.2}\n", "planner.zmp_shift_cap"},
            {"planner: {posture_friction_share: 1.2}\n", "planner.posture_friction_share"},
            {"planner: {posture_support_inset_y: -0.02}\n", "planner.posture_support_inset_y"},
            {"planner: {posture_friction_share: 0}\n", "planner.posture_friction_share"}}) {

@@ -13,7 +13,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
                "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
                "posture_pyramid_edges", "posture_support_inset", "posture_support_inset_y", "posture_friction_share",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle",
-               "swing_check", "verify_transitions", "guide_limb_guess"});
+               "swing_check", "verify_transitions", "guide_limb_guess", "zmp_shift_cap"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
     const double v = f[key].number();
@@ -92,6 +92,11 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     const double v = f["posture_friction_share"].number();
     if (!(v > 0 && v <= 1)) f["posture_friction_share"].fail("a share of the friction coefficient in (0, 1]");
     p.posture.problem.friction_share = v;
+  }
+  // The interpolator's (withScenarioMargins); checked here with the rest of the section.
+  if (f.has("zmp_shift_cap")) {
+    const double v = f["zmp_shift_cap"].number();
+    if (!(v >= 0 && v < 0.1)) f["zmp_shift_cap"].fail("a length in [0, 0.1) m (0: no such bound)");
   }
   if (f.has("box_half_sizes")) {
     const Eigen::Vector3d b = f["box_half_sizes"].vec3();
