@@ -1,7 +1,8 @@
 // The dynamics simulation's speed: simulated seconds per wall second (median
-// over --runs runs) executing step_forward's and sit_down's trajectories
-// (planned and interpolated here first, with the scenarios' margins) and any trajectory files given, with the verdict,
-// the integrator's steps and mean step.
+// over --runs runs) executing step_forward's, sit_down's and chair_feet's
+// trajectories (planned and interpolated here first, with the scenarios'
+// margins and time law; chair_feet's plan takes about 50 s) and any trajectory
+// files given, with the verdict, the integrator's steps and mean step.
 // Usage: bench_simulation [--trajectory T]... [--runs N]; --help lists the options.
 #include <algorithm>
 #include <cstdio>
@@ -39,14 +40,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   int runs = 3;
   CLI::App app{"The dynamics simulation's speed: simulated seconds per wall second (median over the runs) on\n"
-               "step_forward's and sit_down's trajectories (planned and interpolated first) and on each trajectory file given."};
+               "step_forward's, sit_down's and chair_feet's trajectories (planned and interpolated first) and on each trajectory\n"
+               "file given."};
   app.add_option("--trajectory", files, "also this trajectory file (its scenario from its 'scenario' field); repeatable");
   app.add_option("--runs", runs, "runs per trajectory (default 3)")->check(acyclic::bench::positive());
   CLI11_PARSE(app, argc, argv);
 
   std::printf("%-22s %8s %8s %8s %9s %9s %9s  %s\n", "trajectory", "sim s", "wall s", "sim/wall", "min", "steps",
               "mean ms", "verdict");
-  for (const char* name : {"step_forward", "sit_down"}) {
+  for (const char* name : {"step_forward", "sit_down", "chair_feet"}) {
     const Scenario sc = Scenario::load(std::string(ACYCLIC_SOURCE_DIR "/models/scenarios/") + name + ".yaml");
     const PlanningResult p = ContactPlanner(sc, plannerParameters(sc)).plan();
     if (!p.solved()) {
