@@ -2,8 +2,8 @@
 // over --runs runs) executing step_forward's, sit_down's and chair_feet's
 // trajectories (planned here first, transitions verified, then interpolated
 // with the scenarios' margins and time law; chair_feet's plan takes about
-// 50 s) and any trajectory
-// files given, with the verdict, the integrator's steps and mean step.
+// 50 s) and any trajectory files given, with the verdict, the integrator's
+// steps and mean step.
 // Usage: bench_simulation [--trajectory T]... [--runs N]; --help lists the options.
 #include <algorithm>
 #include <cstdio>

@@ -82,8 +82,9 @@ const char* toString(InterpolationResult::Status s);
 // posture_support_inset, posture_support_inset_y and posture_friction_share,
 // and the time law's zmp_shift_cap) where it sets them: the knots between two
 // stances keep the margins the stances were planned with, and a scenario
-// whose single supports need a slow weight shift to execute says so. The interpolator's command line and the plan
-// verifier start from these; a margin given on the command line wins.
+// whose single supports need a slow weight shift to execute says so. The
+// interpolator's command line and the plan verifier start from these; a
+// margin given on the command line wins.
 InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions options);
 
 // The transition solver's options the interpolator uses for these options

@@ -26,6 +26,14 @@ const Scenario& standing() {
 
 int spot(const std::string& name) { return standing().robot->spotIndex(name); }
 
+// The start stance's left sole alone: the right foot in the air.
+std::vector<ContactSpec> leftSoleOnly() {
+  std::vector<ContactSpec> contacts;
+  for (const auto& c : standing().start_stance)
+    if (standing().robot->spots()[c.spot].name == "l_sole") contacts.push_back(c);
+  return contacts;
+}
+
 // A sole's wrench: `fz` newtons straight up, applied at `cop` in the sole's
 // frame (x forward, y left), at the plan's posture.
 hrp2::SpotWrench soleWrench(const Configuration& q, const std::string& sole, double fz, const Eigen::Vector2d& cop) {
@@ -85,9 +93,7 @@ TEST(FeetStabilizer, ASoleLoadedBehindTheWantedPointTurnsItsToeDown) {
   // wanted centre of pressure is the CoM's projection (here between the
   // feet: the nearest point 5 mm inside the sole's inner edge), 2 cm ahead
   // of where the load is measured.
-  std::vector<ContactSpec> contacts;
-  for (const auto& c : sc.start_stance)
-    if (sc.robot->spots()[c.spot].name == "l_sole") contacts.push_back(c);
+  const std::vector<ContactSpec> contacts = leftSoleOnly();
   Kinematics kin(sc.robot);
   kin.setConfiguration(q);
   Eigen::Vector3d com_in_sole = kin.spotPose(spot("l_sole")).inverse() * plannedCom(q);
@@ -188,9 +194,7 @@ TEST(FeetStabilizer, TheCentreOfMassIsJudgedAgainstWhereTheFeetAreNotWhereThePla
 TEST(FeetStabilizer, APressureAlreadyPastAWantedZmpPulledInsideTheSoleIsLeftThere) {
   const Scenario& sc = standing();
   const Configuration& q = sc.start;
-  std::vector<ContactSpec> contacts;
-  for (const auto& c : sc.start_stance)
-    if (sc.robot->spots()[c.spot].name == "l_sole") contacts.push_back(c);
+  const std::vector<ContactSpec> contacts = leftSoleOnly();
   Kinematics kin(sc.robot);
   kin.setConfiguration(q);
   const Eigen::Isometry3d X = kin.spotPose(spot("l_sole"));
@@ -218,9 +222,7 @@ TEST(FeetStabilizer, APressureAlreadyPastAWantedZmpPulledInsideTheSoleIsLeftTher
 TEST(FeetStabilizer, ASwingingSoleThatMeetsTheFloorEarlyYields) {
   const Scenario& sc = standing();
   const Configuration& q = sc.start;
-  std::vector<ContactSpec> contacts;
-  for (const auto& c : sc.start_stance)
-    if (sc.robot->spots()[c.spot].name == "l_sole") contacts.push_back(c);
+  const std::vector<ContactSpec> contacts = leftSoleOnly();
   std::vector<hrp2::SpotWrench> w(sc.robot->spots().size());
   w[spot("l_sole")] = soleWrench(q, "l_sole", 470, {0, 0});
   w[spot("r_sole")] = soleWrench(q, "r_sole", 100, {0, 0});
@@ -244,9 +246,7 @@ TEST(FeetStabilizer, ASwingingSoleThatMeetsTheFloorEarlyYields) {
 TEST(FeetStabilizer, ASwingingSoleIsPlacedWhereThePlanHasItRelativeToTheSupportingSole) {
   const Scenario& sc = standing();
   const Configuration& q = sc.start;
-  std::vector<ContactSpec> contacts;
-  for (const auto& c : sc.start_stance)
-    if (sc.robot->spots()[c.spot].name == "l_sole") contacts.push_back(c);
+  const std::vector<ContactSpec> contacts = leftSoleOnly();
   Kinematics kin(sc.robot);
   kin.setConfiguration(q);
   std::vector<hrp2::SpotWrench> w(sc.robot->spots().size());

@@ -163,18 +163,23 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
   for (const ContactSpec& c : contacts)
     if (isFootSpot(m, c.spot)) down.push_back({c.spot, kin_.spotPose(c.spot), c.supporting});
 
+  // The supporting soles whose frames are measured: their mean offset from
+  // their planned places, and the first of them, which a swinging sole is
+  // placed against.
+  Eigen::Vector2d drift = Eigen::Vector2d::Zero();
+  int measured = 0;
+  const Foot* anchor = nullptr;
+  for (const Foot& f : down)
+    if (f.supporting && wrenches[f.spot].frame) {
+      drift += (wrenches[f.spot].frame->translation() - f.pose.translation()).head<2>();
+      ++measured;
+      if (!anchor) anchor = &f;
+    }
+  if (measured > 0) drift /= measured;
+
   std::vector<bool> regulated(m.spots().size(), false);
   std::fill(want_load_.begin(), want_load_.end(), 0.0);
   if (on && !down.empty()) {
-    // The supporting soles' mean offset from their planned places.
-    Eigen::Vector2d drift = Eigen::Vector2d::Zero();
-    int measured = 0;
-    for (const Foot& f : down)
-      if (f.supporting && wrenches[f.spot].frame) {
-        drift += (wrenches[f.spot].frame->translation() - f.pose.translation()).head<2>();
-        ++measured;
-      }
-    if (measured > 0) drift /= measured;
     zmp_ = plan_com.head<2>() + opt_.zmp_com_gain * (com.head<2>() - drift - plan_com.head<2>()) +
            opt_.zmp_velocity_gain * com_velocity_.head<2>();
     double total = 0;
@@ -262,32 +267,25 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
       } else {
         th *= std::exp(-dt / opt_.cop_leak);
       }
-      for (int i = 0; i < 6; ++i) place_[f.spot][i] *= std::exp(-dt / opt_.place_leak);
+      place_[f.spot] *= std::exp(-dt / opt_.place_leak);
       regulated[f.spot] = true;
     }
   }
-  // The supporting sole a swinging one is placed against: the first
-  // supporting sole of the phase whose frame is measured.
-  const Foot* anchor = nullptr;
-  if (on)
-    for (const Foot& f : down)
-      if (f.supporting && wrenches[f.spot].frame) {
-        anchor = &f;
-        break;
-      }
+  const bool placing = on && anchor && waist;
   for (int s : feet_)
     if (!regulated[s]) {
-      const double f = kin_.spotPose(s).linear().col(2).dot(wrenches[s].force);
-      if (anchor && waist && f > 1.0) {
+      const Eigen::Isometry3d planned = kin_.spotPose(s);
+      const double f = planned.linear().col(2).dot(wrenches[s].force);
+      if (placing && f > 1.0) {
         // Touching the floor already: held where it is.
-      } else if (anchor && waist) {
+      } else if (placing) {
         // Where the plan has this sole relative to the anchor, put on the
         // anchor's measured frame, against where the reference puts it: the
         // plan's sole relative to the waist, on the measured waist. (Not
         // against the measured sole, whose lag behind a moving reference is
         // no placement error.)
-        const Eigen::Isometry3d want = *wrenches[anchor->spot].frame * anchor->pose.inverse() * kin_.spotPose(s);
-        const Eigen::Isometry3d ref = *waist * plan.basePose().inverse() * kin_.spotPose(s);
+        const Eigen::Isometry3d want = *wrenches[anchor->spot].frame * anchor->pose.inverse() * planned;
+        const Eigen::Isometry3d ref = *waist * plan.basePose().inverse() * planned;
         // Along the floor only: across the floor the sole's height and
         // tilt stay the plan's (pushing a sole down against a waist that the
         // push itself tilts would feed on itself; a sole that lands early
@@ -302,7 +300,7 @@ Eigen::VectorXd FeetStabilizer::update(double dt, bool on, const Configuration& 
           x[i] = step(x[i], (std::clamp(target[i], -bound, bound) - x[i]) / opt_.place_time, dt, bound);
         }
       } else {
-        for (int i = 0; i < 6; ++i) place_[s][i] *= std::exp(-dt / opt_.off_time);
+        place_[s] *= std::exp(-dt / opt_.off_time);
       }
       // A swinging foot that meets the floor early (the body sags a few
       // millimetres under its servos' compliance) yields to the load it
