@@ -63,6 +63,13 @@ int main(int argc, char** argv) {
       "built with the interpolator)");
   app.add_flag("--no-verify-transitions", no_verify, "no verification of transitions, whatever the scenario says")
       ->excludes(verify_flag);
+  bool on_expansion = false, no_on_expansion = false;
+  auto* on_expansion_flag = app.add_flag(
+      "--verify-on-expansion", on_expansion,
+      "with the verification of transitions: verify the transitions into each stance before building on it, not "
+      "only when a plan reaches the goal (default: the scenario's planner key verify_on_expansion, else off)");
+  app.add_flag("--no-verify-on-expansion", no_on_expansion, "verify transitions only when a plan reaches the goal")
+      ->excludes(on_expansion_flag);
   std::string keep_refused;
   app.add_option("--keep-refused", keep_refused,
                  "file mode: write each plan the verification refuses to DIR/refused_N.plan.json and its failing "
@@ -74,6 +81,8 @@ int main(int argc, char** argv) {
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   if (verify) o.verify_transitions = 1;
   if (no_verify) o.verify_transitions = 0;
+  if (on_expansion) o.verify_on_expansion = 1;
+  if (no_on_expansion) o.verify_on_expansion = 0;
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
 
   acyclic::proc::installSignalHandlers();
@@ -132,6 +141,9 @@ int main(int argc, char** argv) {
     if (s.plans_verified > 0)
       std::printf("acyclic-planner: transitions verified: %ld plans checked, %ld refused, %ld transitions solved, "
                   "%.2f s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds);
+    if (s.nodes_verified > 0)
+      std::printf("acyclic-planner: verified before expansion: %ld stances, %ld of them dropped (a transition into "
+                  "them cannot be made)\n", s.nodes_verified, s.nodes_refused);
     for (std::size_t i = 0; i < r.refusals.size(); ++i)
       std::printf("acyclic-planner: plan %zu refused at %s\n", i + 1, r.refusals[i].c_str());
     if (r.solved()) {

@@ -48,6 +48,7 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   const bool scenario_says = sc.planner_section && sc.planner_section->has("verify_transitions");
   if (verify_transitions >= 0) p.verify_transitions = verify_transitions == 1;
   else if (!scenario_says) p.verify_transitions = kVerifyTransitionsByDefault;
+  if (verify_on_expansion >= 0) p.verify_on_expansion = verify_on_expansion == 1;
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
   attachPlanVerifier(p, sc);
 #else

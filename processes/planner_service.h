@@ -15,6 +15,7 @@ struct PlannerOverrides {
   int threads = -1;
   bool eager_sons = false, random_candidates = false, distance_to_goal = false, no_failure_memory = false, no_swing_check = false;
   int verify_transitions = -1;  // -1: the scenario's (planner: verify_transitions), 0 off, 1 on
+  int verify_on_expansion = -1;  // -1: the scenario's (planner: verify_on_expansion), 0 off, 1 on
   bool verbose = false;  // one line per expanded node on stderr
   // The scenario's parameters with these overrides; a request's time budget
   // (> 0) applies unless --max-seconds is given. Also sets sc.seed. With

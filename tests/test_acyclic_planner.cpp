@@ -43,6 +43,11 @@ TEST(AcyclicPlanner, VerifiesThePlansTransitionsByDefaultAndNotWhenToldOtherwise
   const auto forced = plan(dir.path() + "/s.yaml", dir.path() + "/forced.json", "--verify-transitions");
   ASSERT_EQ(forced.status, 0) << forced.output;
   EXPECT_NE(forced.output.find("transitions verified"), std::string::npos) << forced.output;
+  EXPECT_EQ(forced.output.find("verified before expansion"), std::string::npos) << forced.output;
+  // Verification on expansion: each expanded stance's transitions checked too, and said.
+  const auto expanding = plan(s, dir.path() + "/expanding.json", "--verify-on-expansion");
+  ASSERT_EQ(expanding.status, 0) << expanding.output;
+  EXPECT_NE(expanding.output.find("verified before expansion"), std::string::npos) << expanding.output;
 }
 
 TEST(AcyclicPlanner, ContradictoryFlagsAndABadKeyAreBadInput) {
@@ -56,6 +61,13 @@ TEST(AcyclicPlanner, ContradictoryFlagsAndABadKeyAreBadInput) {
   EXPECT_EQ(bad.status, 2) << bad.output;
   EXPECT_NE(bad.output.find("verify_transitions"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/p.json"));
+  const auto both_expansion = plan(s, dir.path() + "/p.json", "--verify-on-expansion --no-verify-on-expansion");
+  EXPECT_EQ(both_expansion.status, 2) << both_expansion.output;
+  std::string text2 = acyclic::test::scenarioText("models/scenarios/step_forward.yaml");
+  text2 += "\nplanner:\n  verify_on_expansion: 3\n";
+  const auto bad2 = plan(dir.write("bad2.yaml", text2), dir.path() + "/p.json");
+  EXPECT_EQ(bad2.status, 2) << bad2.output;
+  EXPECT_NE(bad2.output.find("verify_on_expansion"), std::string::npos) << bad2.output;
 }
 
 // --keep-refused DIR: made before the search (a path that cannot be a

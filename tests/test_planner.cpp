@@ -450,6 +450,71 @@ TEST(ContactPlanner, APlanWhoseTransitionTheVerifierRefusesIsDroppedAndTheSearch
     EXPECT_TRUE(same(again.plan.stances[k].configuration, r.plan.stances[k].configuration)) << k;
 }
 
+// Verification on expansion (PlannerParameters::verify_on_expansion): the
+// transitions into a node are verified before any son is built on it, so a
+// refused stance costs no subtree: with the verifier of the test above
+// refusing the plain plan's second stance, the refused node is never
+// expanded, no plan reaching the goal is refused, and fewer nodes are
+// generated than when the refusal waits for a plan through that stance.
+TEST(ContactPlanner, VerificationOnExpansionDropsARefusedStanceBeforeBuildingOnIt) {
+  const Scenario& sc = step();
+  const PlanningResult plain = ContactPlanner(sc).plan();
+  ASSERT_TRUE(plain.solved()) << plain.reason;
+  ASSERT_GE(plain.plan.stances.size(), 3u);
+  const Configuration refused = plain.plan.stances[1].configuration;
+  auto same = [](const Configuration& a, const Configuration& b) {
+    return a.base_position == b.base_position && a.joints == b.joints;
+  };
+  long calls = 0;
+  std::size_t longest = 0;
+  PlannerParameters p;
+  p.verify_transitions = true;
+  p.verify_plan = [&](const Plan& plan, const std::atomic<bool>&) {
+    ++calls;
+    longest = std::max(longest, plan.stances.size());
+    PlanVerdict v;
+    v.transitions = static_cast<int>(plan.stances.size()) - 1;
+    for (std::size_t k = 1; k < plan.stances.size(); ++k)
+      if (same(plan.stances[k].configuration, refused)) {
+        v.failed_from = static_cast<int>(k) - 1, v.failed_to = static_cast<int>(k);
+        v.reason = "refused by the test";
+        break;
+      }
+    return v;
+  };
+  const PlanningResult lazy = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(lazy.solved()) << lazy.reason;
+  ASSERT_GE(lazy.stats.plans_refused, 1);
+  EXPECT_EQ(lazy.stats.nodes_verified, 0);
+
+  PlannerParameters e = p;
+  e.verify_on_expansion = true;
+  calls = 0;
+  std::vector<std::string> trace;
+  e.trace = [&](const std::string& line) { trace.push_back(line); };
+  const PlanningResult r = ContactPlanner(sc, e).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);
+  for (const auto& st : r.plan.stances) EXPECT_FALSE(same(st.configuration, refused));
+  EXPECT_EQ(r.stats.plans_refused, 0);  // the refusal came before any plan through it
+  EXPECT_TRUE(r.refusals.empty());
+  EXPECT_EQ(r.stats.plans_verified, 1);  // the goal's plan
+  EXPECT_GE(r.stats.nodes_refused, 1);
+  EXPECT_GE(calls, r.stats.nodes_verified + r.stats.plans_verified);  // and a settled stance's next witnesses
+  EXPECT_LT(r.stats.nodes_generated, lazy.stats.nodes_generated);
+  // The refused stances' nodes were never expanded: no "expand #N" line of
+  // the trace names a node a "verification: ... node N dropped" line names.
+  std::vector<std::string> dropped;
+  for (const auto& line : trace) {
+    const auto at = line.rfind(" node ");
+    if (line.rfind("verification: stances", 0) == 0 && at != std::string::npos && line.find(" dropped") != std::string::npos)
+      dropped.push_back("expand #" + line.substr(at + 6, line.find(" dropped") - at - 6) + " ");
+  }
+  EXPECT_EQ(dropped.size(), static_cast<std::size_t>(r.stats.nodes_refused));
+  for (const auto& line : trace)
+    for (const auto& d : dropped) EXPECT_NE(line.rfind(d, 0), 0u) << line;
+}
+
 // A verifier that runs past the time budget is stopped, and the search
 // says a plan was found but not verified, instead of returning it.
 TEST(ContactPlanner, AVerificationPastTheTimeBudgetIsStoppedWithTheReason) {

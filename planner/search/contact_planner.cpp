@@ -114,6 +114,7 @@ struct ContactPlanner::Impl {
     int depth = 0;                        // contact changes from the start (set by addNode)
     int changed_spot = -1;                // the spot of the contact added or removed from its parent
     bool dead = false;                    // no plan can be exported through it (exportPlan): not expanded
+    bool verified = false;                // verify_on_expansion: its path was verified
     // The settled stance before it (settledWitness): the candidate used, and
     // the first one allowed (raised when the verifier refuses the transition into it).
     int settled_used = -1, settled_from = 0;
@@ -841,9 +842,11 @@ struct ContactPlanner::Impl {
 
   // Runs the plan verifier with a stop flag raised on a cancel or when the
   // time budget runs out (checked every 20 ms).
-  PlanVerdict verify(const Plan& plan) {
+  // `announce`: the progress callback is told a plan is being verified
+  // (a goal's, not each expanded node's).
+  PlanVerdict verify(const Plan& plan, bool announce) {
     const double start = elapsed();
-    if (progress) {
+    if (progress && announce) {
       stats.seconds = start;
       stats.verifying = true;
       progress(stats);
@@ -866,10 +869,61 @@ struct ContactPlanner::Impl {
     }
     done = true;
     watch.join();
-    ++stats.plans_verified;
+    if (announce) ++stats.plans_verified;
     stats.transitions_solved += v.solved;
     stats.verify_seconds += elapsed() - start;
     return v;
+  }
+
+  // Exports the path to `node` and, with verify_transitions, verifies it.
+  // The first transition that cannot be made drops the node its stance
+  // comes from (and so its subtree); a transition into a settled stance
+  // (between a removal and an addition) first gets that stance's next
+  // witness candidate, and so does one out of a settled stance into its own
+  // node's transition stance (the settled witness is where the added body's
+  // motion starts). Transitions solved once are remembered by the verifier.
+  // Refused goals are recorded in `out` (`goal`); a stop (cancel or budget)
+  // during verification sets the stop's reason.
+  enum class Verified { Ok, Dropped, Stopped };
+  Verified verifyPath(int node, Plan& plan, PlanningResult& out, bool goal) {
+    while (true) {
+      if (!exportPlan(node, plan)) {
+        ++stats.check_refusals;
+        return Verified::Dropped;
+      }
+      if (!p.verify_transitions) return Verified::Ok;
+      const PlanVerdict v = verify(plan, goal);
+      if (v.ok()) return Verified::Ok;
+      if (v.stopped) {
+        budgetLeft();  // the stop's reason: cancel or a budget
+        if (stop == PlanningResult::Status::NoSolution) stop = PlanningResult::Status::TimeLimit;
+        stop_reason = std::string(goal ? "a plan of " + std::to_string(plan.stances.size()) +
+                                             " stances was found but its transitions were not all verified: "
+                                       : "stopped while verifying the transitions into a stance: ") +
+                      stop_reason;
+        return Verified::Stopped;
+      }
+      if (goal) {
+        ++stats.plans_refused;
+        out.refusals.push_back("stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
+                               ": " + v.reason.substr(0, 300));
+        if (p.keep_refused_plans) out.refused_plans.push_back({plan, v.failed_from, v.failed_to, v.reason});
+      }
+      const auto to = static_cast<std::size_t>(v.failed_to);
+      const auto from = static_cast<std::size_t>(v.failed_from);
+      const int owner = stance_owner.at(to);
+      const bool settled_end = stance_settled.at(to) || (stance_settled.at(from) && stance_owner.at(from) == owner);
+      const bool retry = settled_end && nodes[owner].settled_used < 3;
+      if (p.trace)
+        p.trace("verification: stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
+                " cannot be interpolated (" + v.reason.substr(0, 160) + "): node " + std::to_string(owner) +
+                (retry ? ": its settled stance's next witness" : " dropped"));
+      if (!retry) {
+        nodes[owner].dead = true;
+        return Verified::Dropped;
+      }
+      nodes[owner].settled_from = nodes[owner].settled_used + 1;
+    }
   }
 
   bool deadPath(int n) const {
@@ -907,57 +961,14 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   while (true) {
     if (I.goal_node >= 0) {
       // A goal whose plan cannot be exported (a settled stance without a
-      // valid witness) is dropped with the node where it fails; the search
-      // goes on.
-      if (I.exportPlan(I.goal_node, plan)) {
-        if (!I.p.verify_transitions) {
-          exported = true;
-          break;
-        }
-        // Lazy verification: the first transition that cannot be made drops
-        // the node its stance comes from (and so its subtree); the search
-        // goes on. Transitions solved once are remembered by the verifier.
-        const PlanVerdict v = I.verify(plan);
-        if (v.ok()) {
-          exported = true;
-          break;
-        }
-        if (v.stopped) {
-          I.budgetLeft();  // the stop's reason: cancel or a budget
-          if (I.stop == PlanningResult::Status::NoSolution) I.stop = PlanningResult::Status::TimeLimit;
-          I.stop_reason = "a plan of " + std::to_string(plan.stances.size()) +
-                          " stances was found but its transitions were not all verified: " + I.stop_reason;
-          break;
-        }
-        ++I.stats.plans_refused;
-        out.refusals.push_back("stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
-                               ": " + v.reason.substr(0, 300));
-        if (I.p.keep_refused_plans) out.refused_plans.push_back({plan, v.failed_from, v.failed_to, v.reason});
-        const auto to = static_cast<std::size_t>(v.failed_to);
-        const int owner = I.stance_owner.at(to);
-        // A transition into a settled stance (between a removal and an
-        // addition) first gets that stance's next witness candidate (the
-        // removal's own, nearer where the transition starts); the same goal is
-        // exported again. Without one left, the node is dropped.
-        // So does a transition out of a settled stance into its own node's
-        // transition stance (the settled witness is where the added body's
-        // motion starts).
-        const auto from = static_cast<std::size_t>(v.failed_from);
-        const bool settled_end =
-            I.stance_settled.at(to) || (I.stance_settled.at(from) && I.stance_owner.at(from) == owner);
-        const bool retry = settled_end && I.nodes[owner].settled_used < 3;
-        if (I.p.trace)
-          I.p.trace("verification: stances " + std::to_string(v.failed_from) + " -> " + std::to_string(v.failed_to) +
-                    " cannot be interpolated (" + v.reason.substr(0, 160) + "): node " + std::to_string(owner) +
-                    (retry ? ": its settled stance's next witness" : " dropped"));
-        if (retry) {
-          I.nodes[owner].settled_from = I.nodes[owner].settled_used + 1;
-          continue;
-        }
-        I.nodes[owner].dead = true;
-      } else {
-        ++I.stats.check_refusals;
+      // valid witness) or whose transitions cannot all be made is dropped
+      // with the node where it fails; the search goes on.
+      const Impl::Verified v = I.verifyPath(I.goal_node, plan, out, true);
+      if (v == Impl::Verified::Ok) {
+        exported = true;
+        break;
       }
+      if (v == Impl::Verified::Stopped) break;
       I.goal_node = -1;
     }
     if (!I.budgetLeft()) break;
@@ -969,6 +980,17 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
     const Impl::Entry e = I.open.top();
     I.open.pop();
     if (I.deadPath(e.node)) continue;
+    if (I.p.verify_transitions && I.p.verify_on_expansion && !I.nodes[e.node].verified) {
+      // Its path from the start verified before any son is built on it.
+      I.nodes[e.node].verified = true;
+      ++I.stats.nodes_verified;
+      const Impl::Verified v = I.verifyPath(e.node, plan, out, false);
+      if (v == Impl::Verified::Stopped) break;
+      if (v == Impl::Verified::Dropped) {
+        ++I.stats.nodes_refused;
+        continue;
+      }
+    }
     I.expand(e.node, I.p.lazy_sons ? I.nodes[e.node].generator : -1);
     I.stats.seconds = I.elapsed();
     if (progress && I.stats.seconds - last_report >= 0.5) {

@@ -98,6 +98,14 @@ struct PlannerParameters {
   // subtree and the search goes on. Its time counts in max_seconds. Set
   // verify_transitions without a verifier: the planner refuses to start.
   bool verify_transitions = false;
+  // With verify_transitions: the transitions into a node are verified when
+  // it is first selected for expansion (its path from the start exported and
+  // handed to verify_plan), not only when a plan reaches the goal. A stance
+  // that cannot be reached is dropped before the search builds a subtree on
+  // it (on the paper's chair, a foot stepped onto the seat from under the
+  // table's edge: every goal below it was refused, hundreds of nodes each).
+  // Costs one verification per expanded node; transitions are remembered.
+  bool verify_on_expansion = false;
   PlanVerifier verify_plan;
   // Each plan the verifier refuses is kept whole in the result
   // (PlanningResult::refused_plans), to reproduce its failing transition
@@ -126,6 +134,9 @@ struct PlanningStats {
   // Lazy verification (verify_transitions): plans handed to the verifier,
   // refused by it, transitions solved, and the wall time spent in it.
   long plans_verified = 0, plans_refused = 0, transitions_solved = 0;
+  // verify_on_expansion: nodes whose path was verified before their
+  // expansion, and of them dropped (a transition into them cannot be made).
+  long nodes_verified = 0, nodes_refused = 0;
   double verify_seconds = 0;
   bool verifying = false;  // reported while the verifier runs
 };

@@ -13,7 +13,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
                "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
                "posture_pyramid_edges", "posture_support_inset", "posture_support_inset_y", "posture_friction_share",
                "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle",
-               "swing_check", "verify_transitions", "guide_limb_guess", "zmp_shift_cap"});
+               "swing_check", "verify_transitions", "verify_on_expansion", "guide_limb_guess", "zmp_shift_cap"});
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
     const double v = f[key].number();
@@ -46,6 +46,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   if (f.has("swing_check")) p.swing_check = f["swing_check"].boolean();
   if (f.has("guide_limb_guess")) p.guide_limb_guess = f["guide_limb_guess"].boolean();
   if (f.has("verify_transitions")) p.verify_transitions = f["verify_transitions"].boolean();
+  if (f.has("verify_on_expansion")) p.verify_on_expansion = f["verify_on_expansion"].boolean();
   positive("max_seconds", p.max_seconds);
   positive("collision_margin", p.posture.problem.collision_margin);
   count("max_contacts", p.max_contacts);
