@@ -11,6 +11,7 @@
 #include "planner/check/validity.h"
 #include "planner/common/format_error.h"
 #include "planner/guide/guide_author.h"
+#include "planner/guide/guide_postures.h"
 #include "planner/search/contact_planner.h"
 #include "planner/search/guide_potential.h"
 #include "planner/search/planner_parameters.h"
@@ -191,6 +192,25 @@ TEST(GuideAuthor, AGoalBeyondAStepsEdgeEndsStandingOnTheStep) {
   ValidityChecker checker(sc.robot, sc.scene);
   EXPECT_TRUE(checker.checkPosture(end, feet).valid());
   EXPECT_NEAR(end.base_position.z(), sc.robot->posture("half_sitting").base_position.z() + 0.15, 0.05);
+}
+
+// The guide's contacts (contactsMadeBy: its stable path, its stances) leave
+// out a forbidden pair: the right sole on the floor is no contact of it.
+TEST(GuidePostures, AForbiddenPairIsNoContactOfTheGuide) {
+  test::TempDir dir;
+  const std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  const Scenario plain = Scenario::load(dir.write("plain.yaml", text));
+  const Scenario forbidding =
+      Scenario::load(dir.write("forbid.yaml", text + "forbidden_contacts:\n  - {spot: r_sole, surface: floor}\n"));
+  Kinematics kin(plain.robot);
+  const int r_sole = plain.robot->spotIndex("r_sole"), l_sole = plain.robot->spotIndex("l_sole");
+  auto spots = [&](const Scenario& sc) {
+    std::set<int> out;
+    for (const auto& c : contactsMadeBy(sc, kin, sc.start)) out.insert(c.spot);
+    return out;
+  };
+  EXPECT_EQ(spots(plain), (std::set<int>{r_sole, l_sole}));
+  EXPECT_EQ(spots(forbidding), (std::set<int>{l_sole}));
 }
 
 TEST(GuideAuthor, AHeightGoalWithoutSupportsIsRefusedWithTheReason) {

@@ -129,6 +129,35 @@ TEST(ContactPlanner, GoalSupportedByEndsOnTheseSpotsSupporting) {
   EXPECT_EQ(plain_supporting, 1);
 }
 
+// forbidden_contacts: the right sole may never be put back on the floor. The
+// start stands on it (allowed); the search may lift that foot but never land
+// it again: it steps forward far enough with the left foot alone, where
+// unforbidden its plan walks, the right sole landing again.
+TEST(ContactPlanner, AForbiddenPairIsNeverMade) {
+  test::TempDir dir;
+  const std::string text = test::scenarioText("models/scenarios/step_forward.yaml") +
+                           "forbidden_contacts:\n  - {spot: r_sole, surface: floor}\n";
+  const Scenario sc = Scenario::load(dir.write("s.yaml", text));
+  const int r_sole = sc.robot->spotIndex("r_sole");
+  auto landsAgain = [&](const Plan& plan) {  // a stance without the right sole, then one with it
+    bool lifted = false;
+    for (const auto& st : plan.stances) {
+      bool on = false;
+      for (const auto& c : st.contacts) on = on || c.spec.spot == r_sole;
+      if (lifted && on) return true;
+      lifted = lifted || !on;
+    }
+    return false;
+  };
+  const PlanningResult r = ContactPlanner(sc, plannerParameters(sc)).plan();
+  ASSERT_TRUE(r.solved()) << toString(r.status) << ": " << r.reason;
+  expectValidPlan(sc, r.plan);
+  EXPECT_FALSE(landsAgain(r.plan));
+  const PlanningResult plain = ContactPlanner(step(), plannerParameters(step())).plan();
+  ASSERT_TRUE(plain.solved()) << plain.reason;
+  EXPECT_TRUE(landsAgain(plain.plan));
+}
+
 // The small scenario with non-foot contacts: HRP-2 sits down on a chair, the
 // goal needing both thighs on the seat and supporting.
 TEST(ContactPlanner, SitDownIsPlannedWithBothThighsOnTheSeat) {

@@ -127,6 +127,32 @@ TEST(ScenarioFiles, GoalSupportedByNeedsEachSpotSupporting) {
   EXPECT_TRUE(plain.goal.satisfied(k, {}));
 }
 
+// forbidden_contacts takes pairs out of allowed_spots x allowed_surfaces;
+// the start may hold one (the planner only never makes it).
+TEST(ScenarioFiles, ForbiddenContactsTakePairsOutOfTheAllowedOnes) {
+  test::TempDir dir;
+  const Scenario sc = Scenario::load(dir.write(
+      "s.yaml", scenarioText() + "allowed_spots: [r_sole, l_sole, r_palm]\n"
+                                 "forbidden_contacts:\n  - {spot: r_sole, surface: floor}\n"
+                                 "  - {spot: l_sole, surface: chair_seat}\n"));
+  const int r_sole = sc.robot->spotIndex("r_sole"), l_sole = sc.robot->spotIndex("l_sole");
+  const int r_palm = sc.robot->spotIndex("r_palm"), l_palm = sc.robot->spotIndex("l_palm");
+  const int floor = sc.scene->surfaceIndex("floor"), seat = sc.scene->surfaceIndex("chair_seat");
+  ASSERT_EQ(sc.forbidden_contacts.size(), 2u);
+  EXPECT_FALSE(sc.allows(r_sole, floor));  // forbidden, although the start stands on it
+  EXPECT_FALSE(sc.allows(l_sole, seat));
+  EXPECT_TRUE(sc.allows(l_sole, floor));
+  EXPECT_TRUE(sc.allows(r_sole, seat));
+  EXPECT_TRUE(sc.allows(r_palm, seat));
+  EXPECT_FALSE(sc.allows(l_palm, floor));  // not in allowed_spots
+  EXPECT_EQ(sc.start_stance.at(0).spot, r_sole);
+  // Without the key every allowed pair is allowed.
+  const Scenario plain = Scenario::load(dir.write("plain.yaml", scenarioText()));
+  EXPECT_TRUE(plain.forbidden_contacts.empty());
+  EXPECT_TRUE(plain.allows(r_sole, floor));
+  EXPECT_TRUE(plain.allows(l_palm, seat));
+}
+
 TEST(ScenarioFiles, BadFieldsAreNamed) {
   expectFormatError(scenarioText() + "seed: -3\n", "seed", "non-negative");
   expectFormatError(scenarioText("    - {spot: r_foot, surface: floor}\n"), "start.contacts[1].spot", "r_sole");
@@ -143,6 +169,20 @@ TEST(ScenarioFiles, BadFieldsAreNamed) {
                         "allowed_spots: [l_sole]\n",
                     "goal.supported_by[0]", "allowed_spots");
   expectFormatError(scenarioText() + "unexpected: 1\n", "unexpected", "unknown field");
+  expectFormatError(scenarioText() + "forbidden_contacts:\n  - {spot: r_foot, surface: floor}\n",
+                    "forbidden_contacts[0].spot", "r_sole");
+  expectFormatError(scenarioText() + "forbidden_contacts:\n  - {spot: r_sole, surface: roof}\n",
+                    "forbidden_contacts[0].surface", "table_top");
+  expectFormatError(scenarioText() + "allowed_spots: [r_sole]\nforbidden_contacts:\n  - {spot: l_sole, surface: floor}\n",
+                    "forbidden_contacts[0].spot", "allowed_spots");
+  expectFormatError(scenarioText() + "allowed_surfaces: [floor]\n"
+                                     "forbidden_contacts:\n  - {spot: r_sole, surface: chair_seat}\n",
+                    "forbidden_contacts[0].surface", "allowed_surfaces");
+  expectFormatError(scenarioText() + "forbidden_contacts:\n  - {spot: r_sole, surface: floor}\n"
+                                     "  - {spot: r_sole, surface: floor}\n",
+                    "forbidden_contacts[1]", "not already listed");
+  expectFormatError(scenarioText() + "forbidden_contacts:\n  - {spot: r_sole, surface: floor, x: 1}\n",
+                    "forbidden_contacts[0].x", "unknown field");
   std::string wrong_format = scenarioText();
   wrong_format.replace(wrong_format.find("/1"), 2, "/9");
   expectFormatError(wrong_format, "format", "acyclic.scenario/1");

@@ -175,6 +175,14 @@ std::vector<ContactSpec> startContactsBesideSupports(const Scenario& sc) {
   return out;
 }
 
+// Whether the scenario lets every goal support rest on surface si
+// (forbidden_contacts).
+bool supportsAllowedOn(const Scenario& sc, int si) {
+  for (int spot : sc.goal.supporting_spots)
+    if (!sc.allows(spot, si)) return false;
+  return true;
+}
+
 // A level surface no start contact is on (a seat to sit on).
 bool levelSurfaceOffStart(const Scenario& sc, int si) {
   for (const auto& c : sc.start_stance)
@@ -271,6 +279,7 @@ bool goalPostureOnSupports(const Scenario& sc, const GuideOptions& o, PostureGen
   };
   std::vector<Candidate> candidates;
   for (int si : sc.allowed_surfaces) {
+    if (!supportsAllowedOn(sc, si)) continue;
     const Surface& surf = sc.scene->surfaces()[si];
     // The surface's point nearest the start's base, in the surface's plane
     // (the base itself when it is over the surface).
@@ -339,7 +348,7 @@ bool goalPostureSeated(const Scenario& sc, const GuideOptions& o, PostureGenerat
   const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
   const std::vector<ContactSpec> others = startContactsBesideSupports(sc);
   for (int si : sc.allowed_surfaces) {
-    if (!levelSurfaceOffStart(sc, si)) continue;
+    if (!levelSurfaceOffStart(sc, si) || !supportsAllowedOn(sc, si)) continue;
     const Eigen::Vector3d middle = surfaceMiddle(sc.scene->surfaces()[si]);
     for (double d : {0.0, -0.05, 0.05, -0.1, 0.1}) {
       Configuration q = seated;
@@ -441,6 +450,7 @@ bool goalPosture(const Scenario& sc, const GuideOptions& o, PostureTools& t, Con
     for (int s : sc.allowed_surfaces) {
       const Surface& surf = sc.scene->surfaces()[s];
       if (s != floor && surf.frame.linear().col(2).z() < kLevelSurface) continue;
+      if (!sc.allows(r_sole, s) || !sc.allows(l_sole, s)) continue;  // forbidden_contacts
       bool both = true;
       for (int spot : {r_sole, l_sole}) {
         const Eigen::Vector3d p = surf.frame.inverse() * kin.spotPose(spot).translation();

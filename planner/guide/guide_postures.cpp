@@ -37,6 +37,7 @@ std::vector<ContactSpec> contactsMadeBy(const Scenario& sc, Kinematics& kin, con
   std::vector<ContactSpec> out;
   for (int spot : sc.allowed_spots)
     for (int si : sc.allowed_surfaces) {
+      if (!sc.allows(spot, si)) continue;
       const Surface& surf = sc.scene->surfaces()[si];
       if (!spotNearSurface(surf, kin.spotPose(spot), distance, angle)) continue;
       ContactSpec c;

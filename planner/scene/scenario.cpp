@@ -41,6 +41,13 @@ std::string Scenario::describe(const ContactSpec& c) const {
          (c.supporting ? " (supporting)" : " (geometric only)");
 }
 
+bool Scenario::allows(int spot, int surface) const {
+  auto isIn = [](const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); };
+  return isIn(allowed_spots, spot) && isIn(allowed_surfaces, surface) &&
+         std::find(forbidden_contacts.begin(), forbidden_contacts.end(), std::make_pair(spot, surface)) ==
+             forbidden_contacts.end();
+}
+
 Scenario Scenario::load(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw FormatError(path, "", "cannot open the file");
@@ -53,7 +60,7 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   YamlField root = YamlField::loadText(text, origin);
   root.requireFormat("acyclic.scenario/1");
   root.allowOnly({"format", "name", "robot", "scene", "seed", "start", "allowed_spots", "allowed_surfaces",
-                  "goal", "key_postures", "planner"});
+                  "forbidden_contacts", "goal", "key_postures", "planner"});
   Scenario sc;
   sc.path = origin;
   sc.name = root.has("name") ? root["name"].string() : fs::path(origin).stem().string();
@@ -123,6 +130,22 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   } else {
     for (std::size_t i = 0; i < sc.scene->surfaces().size(); ++i)
       sc.allowed_surfaces.push_back(static_cast<int>(i));
+  }
+
+  auto isIn = [](const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); };
+  if (root.has("forbidden_contacts")) {
+    YamlField a = root["forbidden_contacts"];
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      YamlField c = a.at(i);
+      c.allowOnly({"spot", "surface"});
+      const int spot = spotOf(c["spot"]), surface = surfaceOf(c["surface"]);
+      if (!isIn(sc.allowed_spots, spot)) c["spot"].fail("one of allowed_spots");
+      if (!isIn(sc.allowed_surfaces, surface)) c["surface"].fail("one of allowed_surfaces");
+      const std::pair<int, int> pair{spot, surface};
+      if (std::find(sc.forbidden_contacts.begin(), sc.forbidden_contacts.end(), pair) != sc.forbidden_contacts.end())
+        c.fail("a pair not already listed");
+      sc.forbidden_contacts.push_back(pair);
+    }
   }
 
   YamlField goal = root["goal"];

@@ -50,6 +50,10 @@ struct Scenario {
   std::vector<ContactSpec> start_stance;
   std::vector<int> allowed_spots;
   std::vector<int> allowed_surfaces;
+  // Pairs (spot, surface) the planner never makes although the spot and the
+  // surface are both allowed (chair_paper: the soles and knees never on the
+  // chair's seat, so that a hand must do what the paper's robot did).
+  std::vector<std::pair<int, int>> forbidden_contacts;
   GoalCondition goal;
   std::vector<Configuration> key_postures;
   std::uint64_t seed = 1;
@@ -63,6 +67,9 @@ struct Scenario {
   static Scenario loadText(const std::string& text, const std::string& origin, const std::string& base_dir);
 
   std::string describe(const ContactSpec& c) const;  // "r_sole@floor (supporting)"
+  // Whether the planner may put `spot` on `surface`: both allowed, the pair
+  // not forbidden.
+  bool allows(int spot, int surface) const;
 };
 
 }  // namespace acyclic

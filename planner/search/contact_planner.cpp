@@ -624,6 +624,7 @@ struct ContactPlanner::Impl {
       for (const auto& c : nodes[ni].contacts) used = used || c.spot == spot;
       if (used) continue;
       for (int surface : sc.allowed_surfaces) {
+        if (!sc.allows(spot, surface)) continue;  // forbidden_contacts
         if (rememberedFailure(ni, spot, surface)) continue;
         kin.setConfiguration(nodes[ni].q);
         if (!reachable(spot, surface, kin)) continue;
