@@ -191,7 +191,12 @@ TEST(ContactPlanner, ThePapersChairCannotBeLeftOnTheFeetAlone) {
                             "                r_forearm, l_forearm, r_wrist, l_wrist, r_palm, l_palm]";
   ASSERT_NE(text.find(spots), std::string::npos);
   text.replace(text.find(spots), spots.size(), "allowed_spots: [r_sole, l_sole, r_thigh, l_thigh]");
+  // The feet allowed on the seat too: no foot placement is held back.
+  const std::size_t forbidden = text.find("forbidden_contacts:");
+  ASSERT_NE(forbidden, std::string::npos);
+  text.replace(forbidden, text.find("\n\n", forbidden) - forbidden, "");
   const Scenario sc = Scenario::load(dir.write("feet_only.yaml", text));
+  ASSERT_TRUE(sc.forbidden_contacts.empty());
   PlannerParameters params = plannerParameters(sc);
   params.max_seconds = 600;  // budgets far beyond what the search needs
   ContactPlanner planner(sc, params);

@@ -132,15 +132,14 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
       sc.allowed_surfaces.push_back(static_cast<int>(i));
   }
 
-  auto isIn = [](const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); };
   if (root.has("forbidden_contacts")) {
     YamlField a = root["forbidden_contacts"];
     for (std::size_t i = 0; i < a.size(); ++i) {
       YamlField c = a.at(i);
       c.allowOnly({"spot", "surface"});
+      // A pair outside allowed_spots or allowed_surfaces is accepted (it is
+      // never made anyway): a scenario narrowed to fewer spots keeps its list.
       const int spot = spotOf(c["spot"]), surface = surfaceOf(c["surface"]);
-      if (!isIn(sc.allowed_spots, spot)) c["spot"].fail("one of allowed_spots");
-      if (!isIn(sc.allowed_surfaces, surface)) c["surface"].fail("one of allowed_surfaces");
       const std::pair<int, int> pair{spot, surface};
       if (std::find(sc.forbidden_contacts.begin(), sc.forbidden_contacts.end(), pair) != sc.forbidden_contacts.end())
         c.fail("a pair not already listed");
