@@ -52,7 +52,7 @@ struct Scenario {
   std::vector<int> allowed_surfaces;
   // Pairs (spot, surface) the planner never makes although the spot and the
   // surface are both allowed (chair_paper: the soles and knees never on the
-  // chair's seat, so that a hand must do what the paper's robot did).
+  // chair's seat, as the paper's robot kept them). The start may hold one.
   std::vector<std::pair<int, int>> forbidden_contacts;
   GoalCondition goal;
   std::vector<Configuration> key_postures;
