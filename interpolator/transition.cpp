@@ -649,22 +649,19 @@ std::optional<LimbJointPath> TransitionSolver::plannedLimbJoints(const Configura
   // Narrower where the limb must pass a gap (a forearm between a table's
   // edge and the trunk, 5 mm from the edge in both witnesses: no path 10 mm
   // clear, one 3 mm clear); the knots keep the posture generator's margin
-  // around it and every sample is checked.
+  // around it and every sample is checked. Then the narrow passes again with
+  // ten times the states: an arm hanging behind the pelvis, swung up onto a
+  // table's top past its edge, has a path 5 mm clear that RRTConnect finds
+  // in 200,000 checks and not in 20,000 (chair_paper with its feet kept off
+  // the seat, 160 -> 161; about 10 us a check, so this costs seconds only
+  // where no path exists).
   const double wide = lo.clearance;
   const long checks = lo.max_checks;
-  for (double clearance : {wide, 0.005, 0.003}) {
+  const std::pair<double, long> tries[] = {
+      {wide, checks}, {0.005, checks}, {0.003, checks}, {0.005, 10 * checks}, {0.003, 10 * checks}};
+  for (const auto& [clearance, budget] : tries) {
     lo.clearance = clearance;
-    LimbPathPlan planned = planLimbPath(collisions_, kin_, root, q0, q1, lo);
-    if (planned.path) return std::move(planned.path);
-  }
-  // Then the narrow passes again with ten times the states: an arm hanging
-  // behind the pelvis, swung up onto a table's top past its edge, has a path
-  // 5 mm clear that RRTConnect finds in 200,000 checks and not in 20,000
-  // (chair_paper with its feet kept off the seat, 160 -> 161; about 10 us a
-  // check, so this costs seconds only where no path exists).
-  lo.max_checks = 10 * checks;
-  for (double clearance : {0.005, 0.003}) {
-    lo.clearance = clearance;
+    lo.max_checks = budget;
     LimbPathPlan planned = planLimbPath(collisions_, kin_, root, q0, q1, lo);
     if (planned.path) return std::move(planned.path);
   }
