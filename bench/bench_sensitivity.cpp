@@ -41,13 +41,17 @@ int main(int argc, char** argv) {
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::string path = ACYCLIC_SOURCE_DIR "/models/scenarios/chair_table.yaml";
   double max_seconds = -1;
+  int max_nodes = -1;
   int threads = 2;
+  std::vector<std::string> only;
   CLI::App app{"One scenario planned under perturbations that change only the last bits of the witnesses (the start\n"
                "moved by 1e-9 m, the other distance engine, KKT variant or barrier oracle, the seed): each run's\n"
                "result, nodes and time, and the spread of the node counts about their median."};
   app.add_option("scenario", path, "scenario file (acyclic.scenario/1; default: models/scenarios/chair_table.yaml)");
   app.add_option("--max-seconds", max_seconds, "time budget per run, s (default: the scenario's)")
       ->check(acyclic::bench::positive());
+  app.add_option("--max-nodes", max_nodes, "node budget per run (default: the scenario's)")->check(CLI::PositiveNumber);
+  app.add_option("--only", only, "run only these perturbations, by name (repeatable; default: all)");
   app.add_option("--threads", threads, "posture generators at once (the plan does not depend on it)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -73,13 +77,22 @@ int main(int argc, char** argv) {
        }},
       {"seed 2", [](Scenario& sc, PlannerParameters&) { sc.seed = 2; }},
   };
+  for (const auto& name : only)
+    if (std::none_of(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == name; })) {
+      std::fprintf(stderr, "bench_sensitivity: --only: no perturbation named '%s' (see the first column)\n",
+                   name.c_str());
+      return 2;
+    }
   std::printf("%-22s %-16s %7s %9s\n", "perturbation", "result", "nodes", "seconds");
   std::vector<double> nodes;
-  int solved = 0;
+  int solved = 0, runs = 0;
   for (const auto& v : variants) {
+    if (!only.empty() && std::find(only.begin(), only.end(), v.name) == only.end()) continue;
+    ++runs;
     Scenario sc = Scenario::load(path);
     PlannerParameters p = plannerParameters(sc);
     if (max_seconds > 0) p.max_seconds = max_seconds;
+    if (max_nodes > 0) p.max_nodes = max_nodes;
     p.threads = threads;
     v.apply(sc, p);
     const PlanningResult r = ContactPlanner(sc, p).plan();
@@ -88,7 +101,7 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     if (r.solved()) ++solved, nodes.push_back(static_cast<double>(r.stats.nodes_generated));
   }
-  std::printf("solved %d of %zu", solved, variants.size());
+  std::printf("solved %d of %d", solved, runs);
   if (!nodes.empty()) {
     const double m = median(nodes);
     std::printf("; nodes of the solved runs: median %.0f, largest %.2fx and smallest %.2fx the median", m,
