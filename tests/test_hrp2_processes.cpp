@@ -191,7 +191,7 @@ class Hrp2Processes : public ::testing::Test {
   // A shared machine stalls a process for 10-40 ms now and then
   // (bench_bridge_jitter: max wake-up delay), which the default 10 ms state
   // watchdog rightly calls stale. Tests that are not about the watchdog use
-  // the configuration for a simulator on such a machine (50 ms); the watchdog
+  // the configuration for a simulator on such a machine (100 ms); the watchdog
   // test keeps the default.
   std::string tolerantConfig(bool contract = true) {
     const std::string simulated = test::sourcePath("hrp2_bridge/config/simulated.yaml");
