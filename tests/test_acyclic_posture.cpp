@@ -77,12 +77,12 @@ TEST(AcyclicPosture, ThePapersChairReleasesOneThighOnTheFeetButNotBoth) {
   // models/scenarios/chair_paper.yaml: the table over the thighs keeps the
   // trunk from bringing the centre of mass over the feet. One thigh leaves
   // the seat (the other and the feet carry the robot); both do not, even
-  // with ten times the iterations the planner gives a posture call.
+  // with ten times the iterations the planner gives a posture call there.
   const std::string bin = acyclic::test::binaryPath("processes/acyclic-posture") + " " +
                           acyclic::test::sourcePath("models/scenarios/chair_paper.yaml");
   const auto one = acyclic::test::runProcess(bin + " --remove r_thigh");
   EXPECT_EQ(one.status, 0) << one.output;
-  const auto both = acyclic::test::runProcess(bin + " --remove r_thigh --remove l_thigh --iterations 400");
+  const auto both = acyclic::test::runProcess(bin + " --remove r_thigh --remove l_thigh --iterations 1000");
   EXPECT_EQ(both.status, 1) << both.output;
 }
 
