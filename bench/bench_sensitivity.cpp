@@ -53,6 +53,8 @@ int main(int argc, char** argv) {
       {"start y + 1e-9 m", shift(1, 1e-9)},
       {"start z + 1e-9 m", shift(2, 1e-9)},
       {"start x - 1e-9 m", shift(0, -1e-9)},
+      {"start y - 1e-9 m", shift(1, -1e-9)},
+      {"start z - 1e-9 m", shift(2, -1e-9)},
       // Each the other choice than the scenario's (the planner's defaults: FCL, exact Hessian, quality function).
       {"other distance engine",
        [](Scenario&, PlannerParameters& p) {
@@ -80,6 +82,12 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "posture generators at once (the plan does not depend on it)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
+  try {  // a bad scenario (file and field named) before any run, not an abort in the first
+    plannerParameters(Scenario::load(path));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_sensitivity: %s\n", e.what());
+    return 2;
+  }
   std::printf("%-22s %-16s %7s %9s\n", "perturbation", "result", "nodes", "seconds");
   std::vector<double> nodes;
   int solved = 0, runs = 0;
