@@ -82,8 +82,13 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "posture generators at once (the plan does not depend on it)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  try {  // a bad scenario (file and field named) before any run, not an abort in the first
-    plannerParameters(Scenario::load(path));
+  // Loaded and read once, before any run (a bad scenario is said with its
+  // file and field, not an abort); each run perturbs its own copy.
+  Scenario loaded;
+  PlannerParameters shipped;
+  try {
+    loaded = Scenario::load(path);
+    shipped = plannerParameters(loaded);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_sensitivity: %s\n", e.what());
     return 2;
@@ -94,8 +99,8 @@ int main(int argc, char** argv) {
   for (const auto& v : variants) {
     if (!only.empty() && std::find(only.begin(), only.end(), v.name) == only.end()) continue;
     ++runs;
-    Scenario sc = Scenario::load(path);
-    PlannerParameters p = plannerParameters(sc);
+    Scenario sc = loaded;
+    PlannerParameters p = shipped;
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (max_nodes > 0) p.max_nodes = max_nodes;
     p.threads = threads;
