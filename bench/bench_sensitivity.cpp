@@ -6,6 +6,9 @@
 // other barrier oracle, the seed (the search draws nothing at random with
 // optimized candidates, so the seed is a control: the same nodes). Prints each run (result, nodes, seconds)
 // and the spread: the median, and the largest and smallest over the median.
+// A scenario with a portfolio (planner: portfolio) is planned with it, each
+// member perturbed: the winner's nodes, and those of all the members
+// (the loser stops past the winner's count); --member plans with one alone.
 // Usage: bench_sensitivity [SCENARIO] [OPTIONS]   (default: chair_table); --help lists the options.
 #include <algorithm>
 #include <cstdio>
@@ -24,9 +27,12 @@ using namespace acyclic;
 
 namespace {
 
+// A perturbation of the scenario, or of the planner's parameters: with a
+// portfolio, of each member's (applied after the member's own changes).
 struct Variant {
   std::string name;
-  std::function<void(Scenario&, PlannerParameters&)> apply;
+  std::function<void(Scenario&)> scenario;
+  std::function<void(PlannerParameters&)> params;
 };
 
 double median(std::vector<double> v) {
@@ -43,30 +49,31 @@ int main(int argc, char** argv) {
   double max_seconds = -1;
   int max_nodes = -1;
   int threads = 2;
+  std::string member;  // of the scenario's portfolio, alone
   std::vector<std::string> only;
   auto shift = [](int axis, double by) {
-    return [axis, by](Scenario& sc, PlannerParameters&) { sc.start.base_position[axis] += by; };
+    return [axis, by](Scenario& sc) { sc.start.base_position[axis] += by; };
   };
   const std::vector<Variant> variants = {
-      {"as shipped", [](Scenario&, PlannerParameters&) {}},
-      {"start x + 1e-9 m", shift(0, 1e-9)},
-      {"start y + 1e-9 m", shift(1, 1e-9)},
-      {"start z + 1e-9 m", shift(2, 1e-9)},
-      {"start x - 1e-9 m", shift(0, -1e-9)},
-      {"start y - 1e-9 m", shift(1, -1e-9)},
-      {"start z - 1e-9 m", shift(2, -1e-9)},
+      {"as shipped", {}, {}},
+      {"start x + 1e-9 m", shift(0, 1e-9), {}},
+      {"start y + 1e-9 m", shift(1, 1e-9), {}},
+      {"start z + 1e-9 m", shift(2, 1e-9), {}},
+      {"start x - 1e-9 m", shift(0, -1e-9), {}},
+      {"start y - 1e-9 m", shift(1, -1e-9), {}},
+      {"start z - 1e-9 m", shift(2, -1e-9), {}},
       // Each the other choice than the scenario's (the planner's defaults: FCL, exact Hessian, quality function).
-      {"other distance engine",
-       [](Scenario&, PlannerParameters& p) {
+      {"other distance engine", {},
+       [](PlannerParameters& p) {
          p.posture.distance_engine =
              p.posture.distance_engine == DistanceEngine::Fcl ? DistanceEngine::Convex : DistanceEngine::Fcl;
        }},
-      {"other KKT Hessian", [](Scenario&, PlannerParameters& p) { p.posture.lbfgs_in_kkt = !p.posture.lbfgs_in_kkt; }},
-      {"other mu oracle",
-       [](Scenario&, PlannerParameters& p) {
+      {"other KKT Hessian", {}, [](PlannerParameters& p) { p.posture.lbfgs_in_kkt = !p.posture.lbfgs_in_kkt; }},
+      {"other mu oracle", {},
+       [](PlannerParameters& p) {
          p.posture.mu_oracle = p.posture.mu_oracle == "probing" ? "quality-function" : "probing";
        }},
-      {"seed 2", [](Scenario& sc, PlannerParameters&) { sc.seed = 2; }},
+      {"seed 2", [](Scenario& sc) { sc.seed = 2; }, {}},
   };
   CLI::App app{"One scenario planned under perturbations that change only the last bits of the witnesses (the start\n"
                "moved by 1e-9 m, the other distance engine, KKT variant or barrier oracle, the seed): each run's\n"
@@ -80,6 +87,9 @@ int main(int argc, char** argv) {
   app.add_option("--only", only, "run only these perturbations, by name (repeatable; default: all)")
       ->check(CLI::IsMember(names));
   app.add_option("--threads", threads, "posture generators at once (the plan does not depend on it)")->capture_default_str();
+  app.add_option("--member", member,
+                 "of the scenario's portfolio (planner: portfolio), plan with this member alone, by name "
+                 "(default: the whole portfolio)");
   CLI11_PARSE(app, argc, argv);
 
   // Loaded and read once, before any run (a bad scenario is said with its
@@ -89,12 +99,23 @@ int main(int argc, char** argv) {
   try {
     loaded = Scenario::load(path);
     shipped = plannerParameters(loaded);
+    if (!member.empty()) {
+      const auto m = std::find_if(shipped.portfolio.begin(), shipped.portfolio.end(),
+                                  [&](const PlannerVariant& v) { return v.name == member; });
+      if (m == shipped.portfolio.end())
+        throw std::invalid_argument(path + ": --member " + member + ": no such member in planner.portfolio");
+      const PlannerVariant alone = *m;
+      shipped.portfolio.clear();
+      if (alone.apply) alone.apply(shipped);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_sensitivity: %s\n", e.what());
     return 2;
   }
-  std::printf("%-22s %-16s %7s %9s\n", "perturbation", "result", "nodes", "seconds");
-  std::vector<double> nodes;
+  const bool portfolio = !shipped.portfolio.empty();
+  std::printf("%-22s %-16s %7s %9s%s\n", "perturbation", "result", "nodes", "seconds",
+              portfolio ? "  winner (nodes generated by all the members)" : "");
+  std::vector<double> nodes, all_nodes;
   int solved = 0, runs = 0;
   for (const auto& v : variants) {
     if (!only.empty() && std::find(only.begin(), only.end(), v.name) == only.end()) continue;
@@ -104,18 +125,39 @@ int main(int argc, char** argv) {
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (max_nodes > 0) p.max_nodes = max_nodes;
     p.threads = threads;
-    v.apply(sc, p);
+    if (v.scenario) v.scenario(sc);
+    if (v.params) {
+      if (!portfolio) v.params(p);
+      for (PlannerVariant& m : p.portfolio)  // each member perturbed after its own changes
+        m.apply = [own = m.apply, perturb = v.params](PlannerParameters& q) {
+          if (own) own(q);
+          perturb(q);
+        };
+    }
     const PlanningResult r = ContactPlanner(sc, p).plan();
-    std::printf("%-22s %-16s %7ld %9.2f\n", v.name.c_str(), toString(r.status), r.stats.nodes_generated,
+    std::printf("%-22s %-16s %7ld %9.2f", v.name.c_str(), toString(r.status), r.stats.nodes_generated,
                 r.stats.seconds);
+    if (portfolio)
+      std::printf("  %s (%ld)", r.winner >= 0 ? r.members[r.winner].name.c_str() : "none", r.portfolioNodes());
+    std::printf("\n");
     std::fflush(stdout);
-    if (r.solved()) ++solved, nodes.push_back(static_cast<double>(r.stats.nodes_generated));
+    if (r.solved()) {
+      ++solved;
+      nodes.push_back(static_cast<double>(r.stats.nodes_generated));
+      all_nodes.push_back(static_cast<double>(r.portfolioNodes()));
+    }
   }
   std::printf("solved %d of %d", solved, runs);
   if (!nodes.empty()) {
     const double m = median(nodes);
     std::printf("; nodes of the solved runs: median %.0f, largest %.2fx and smallest %.2fx the median", m,
                 *std::max_element(nodes.begin(), nodes.end()) / m, *std::min_element(nodes.begin(), nodes.end()) / m);
+    if (portfolio) {
+      const double a = median(all_nodes);
+      std::printf("; nodes generated by all the members: median %.0f, largest %.2fx and smallest %.2fx the median", a,
+                  *std::max_element(all_nodes.begin(), all_nodes.end()) / a,
+                  *std::min_element(all_nodes.begin(), all_nodes.end()) / a);
+    }
   }
   std::printf("\n");
   return 0;

@@ -44,7 +44,9 @@ PlanVerifier makePlanVerifier(const Scenario& sc, const InterpolatorOptions& opt
 
 // Gives p a verifier when p.verify_transitions is set and it has none:
 // with these options, or by default the interpolator's with the scenario's
-// margins (withScenarioMargins), as the interpolator will solve them.
+// margins (withScenarioMargins), as the interpolator will solve them. And,
+// unless it has one, a factory of such verifiers (make_verifier): one per
+// member of a portfolio.
 void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options);
 void attachPlanVerifier(PlannerParameters& p, const Scenario& sc);
 

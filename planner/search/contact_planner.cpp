@@ -15,6 +15,7 @@
 #include "planner/collision/collision_model.h"
 #include "planner/search/swing_check.h"
 #include "planner/search/guide_potential.h"
+#include "planner/search/portfolio.h"
 
 namespace acyclic {
 
@@ -934,11 +935,25 @@ struct ContactPlanner::Impl {
   }
 };
 
-ContactPlanner::ContactPlanner(const Scenario& scenario, PlannerParameters params)
-    : impl_(std::make_unique<Impl>(scenario, std::move(params))) {}
+long PlanningResult::portfolioNodes() const {
+  if (members.empty()) return stats.nodes_generated;
+  long n = 0;
+  for (const Member& m : members) n += m.stats.nodes_generated;
+  return n;
+}
+
+ContactPlanner::ContactPlanner(const Scenario& scenario, PlannerParameters params) {
+  if (params.portfolio.empty()) impl_ = std::make_unique<Impl>(scenario, std::move(params));
+  else portfolio_ = std::make_unique<Portfolio>(scenario, params);
+}
 ContactPlanner::~ContactPlanner() = default;
 
 PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progress& progress) {
+  return portfolio_ ? portfolio_->plan(cancel, progress) : search(cancel, progress, nullptr);
+}
+
+PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Progress& progress,
+                                      const std::atomic<long>* node_cap) {
   Impl& I = *impl_;
   I.t0 = std::chrono::steady_clock::now();
   I.cancel = cancel;
@@ -960,6 +975,14 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   Plan plan;
   bool exported = false;
   while (true) {
+    if (node_cap && I.stats.nodes_generated > node_cap->load()) {
+      // Checked here only, where a search alone would check its goal: up to
+      // this point the search is the one it makes alone (portfolio.h).
+      I.stop = PlanningResult::Status::Cancelled;
+      I.stop_reason = "outrun: another member of the portfolio solved, and this one is past " +
+                      std::to_string(node_cap->load()) + " nodes";
+      break;
+    }
     if (I.goal_node >= 0) {
       // A goal whose plan cannot be exported (a settled stance without a
       // valid witness) or whose transitions cannot all be made is dropped

@@ -4,16 +4,20 @@
 
 namespace acyclic {
 
-PlannerParameters plannerParameters(const Scenario& sc) {
-  PlannerParameters p;
-  if (!sc.planner_section) return p;
-  const YamlField& f = *sc.planner_section;
-  f.allowOnly({"potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step", "threads", "box_half_sizes", "duplicate_distance", "duplicate_angle",
-               "max_contacts", "max_nodes", "max_posture_calls", "max_seconds", "posture_iterations", "posture_linear_solver",
-               "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle", "posture_distance_engine",
-               "posture_pyramid_edges", "posture_support_inset", "posture_support_inset_y", "posture_friction_share",
-               "collision_margin", "failure_memory", "failure_memory_distance", "failure_memory_angle",
-               "swing_check", "verify_transitions", "verify_on_expansion", "guide_limb_guess", "zmp_shift_cap"});
+namespace {
+
+// What a member of a portfolio may change: how the search searches, not its
+// budgets, threads or verification (those are the planner's, shared).
+const std::vector<std::string> kVariantKeys = {
+    "potential_k", "smoothing_tolerance", "guide_joint_weight", "reach_slack", "depth_weight", "alternative_step",
+    "box_half_sizes", "duplicate_distance", "duplicate_angle", "max_contacts", "posture_iterations",
+    "posture_linear_solver", "posture_lbfgs_in_kkt", "posture_stop_at_restoration", "posture_mu_oracle",
+    "posture_distance_engine", "posture_pyramid_edges", "posture_support_inset", "posture_support_inset_y",
+    "posture_friction_share", "collision_margin", "failure_memory", "failure_memory_distance",
+    "failure_memory_angle", "swing_check", "guide_limb_guess"};
+
+// Sets in p every key f has (f's keys already allowed by the caller).
+void readFields(const YamlField& f, PlannerParameters& p) {
   auto positive = [&](const char* key, double& out) {
     if (!f.has(key)) return;
     const double v = f[key].number();
@@ -104,6 +108,45 @@ PlannerParameters plannerParameters(const Scenario& sc) {
     if ((b.array() <= 0).any()) f["box_half_sizes"].fail("three positive half sizes [x (m), y (m), theta (rad)]");
     p.box = {b.x(), b.y(), b.z()};
   }
+}
+
+// planner: portfolio: a list of members, each a map of the keys above (and
+// an optional name) applied to the planner's parameters.
+std::vector<PlannerVariant> portfolioOf(const YamlField& list, const PlannerParameters& base) {
+  if (!list.isSequence() || list.size() < 2)
+    list.fail("a list of at least two members, each a map of planner keys to change (an empty map: as configured)");
+  std::vector<std::string> allowed = kVariantKeys;
+  allowed.push_back("name");
+  std::vector<PlannerVariant> members;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YamlField m = list.at(i);
+    if (!m.isMap()) m.fail("a map of planner keys to change ({} for the planner as configured)");
+    m.allowOnly(allowed);
+    PlannerVariant v;
+    v.name = m.has("name") ? m["name"].string() : "member " + std::to_string(i + 1);
+    for (const PlannerVariant& other : members)
+      if (other.name == v.name) (m.has("name") ? m["name"] : m).fail("a name no other member has");
+    PlannerParameters check = base;  // bad values fail here, naming the file and field
+    readFields(m, check);
+    v.apply = [m](PlannerParameters& p) { readFields(m, p); };
+    members.push_back(std::move(v));
+  }
+  return members;
+}
+
+}  // namespace
+
+PlannerParameters plannerParameters(const Scenario& sc) {
+  PlannerParameters p;
+  if (!sc.planner_section) return p;
+  const YamlField& f = *sc.planner_section;
+  std::vector<std::string> allowed = kVariantKeys;
+  for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_seconds", "verify_transitions",
+                          "verify_on_expansion", "zmp_shift_cap", "portfolio"})
+    allowed.push_back(key);
+  f.allowOnly(allowed);
+  readFields(f, p);
+  if (f.has("portfolio")) p.portfolio = portfolioOf(f["portfolio"], p);
   return p;
 }
 

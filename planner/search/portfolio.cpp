@@ -1,0 +1,160 @@
+#include "planner/search/portfolio.h"
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <condition_variable>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace acyclic {
+
+namespace {
+
+// What a caller's progress sees while members run: their counts summed,
+// the longest time, the best key.
+PlanningStats combined(const std::vector<PlanningStats>& all) {
+  PlanningStats s;
+  bool first = true;
+  for (const PlanningStats& m : all) {
+    s.nodes_generated += m.nodes_generated;
+    s.nodes_expanded += m.nodes_expanded;
+    s.posture_calls += m.posture_calls;
+    s.posture_failures += m.posture_failures;
+    s.check_refusals += m.check_refusals;
+    s.pairs_remembered += m.pairs_remembered;
+    s.calls_ahead_unused += m.calls_ahead_unused;
+    s.limb_retries += m.limb_retries;
+    s.limb_retry_successes += m.limb_retry_successes;
+    s.plans_verified += m.plans_verified;
+    s.plans_refused += m.plans_refused;
+    s.transitions_solved += m.transitions_solved;
+    s.nodes_verified += m.nodes_verified;
+    s.nodes_refused += m.nodes_refused;
+    s.verify_seconds += m.verify_seconds;
+    s.seconds = std::max(s.seconds, m.seconds);
+    s.verifying = s.verifying || m.verifying;
+    if (m.nodes_generated > 0 && (first || m.best_potential < s.best_potential)) {
+      s.best_potential = m.best_potential;
+      first = false;
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerParameters& params) {
+  const int n = static_cast<int>(params.portfolio.size());
+  // Shared by the members when there is no factory of verifiers, and for
+  // the caller's trace: one call at a time.
+  auto verify_lock = std::make_shared<std::mutex>();
+  auto trace_lock = std::make_shared<std::mutex>();
+  for (const PlannerVariant& v : params.portfolio) {
+    for (const std::string& other : names)
+      if (other == v.name) throw std::invalid_argument("portfolio: two members named \"" + v.name + "\"");
+    PlannerParameters p = params;
+    p.portfolio.clear();
+    if (v.apply) v.apply(p);
+    if (!p.portfolio.empty())
+      throw std::invalid_argument("portfolio member \"" + v.name + "\": a member cannot hold a portfolio");
+    p.threads = std::max(1, params.threads / n);
+    if (p.verify_transitions) {
+      if (p.make_verifier) {
+        p.verify_plan = p.make_verifier();
+      } else if (p.verify_plan) {
+        PlanVerifier shared = p.verify_plan;
+        p.verify_plan = [verify_lock, shared](const Plan& plan, const std::atomic<bool>& stop) {
+          std::lock_guard<std::mutex> hold(*verify_lock);
+          return shared(plan, stop);
+        };
+      }
+    }
+    if (p.trace) {
+      auto trace = p.trace;
+      const std::string prefix = "[" + v.name + "] ";
+      p.trace = [trace_lock, trace, prefix](const std::string& line) {
+        std::lock_guard<std::mutex> hold(*trace_lock);
+        trace(prefix + line);
+      };
+    }
+    names.push_back(v.name);
+    members.push_back(std::make_unique<ContactPlanner>(scenario, std::move(p)));
+  }
+}
+
+PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, const Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = members.size();
+  std::unique_ptr<std::atomic<long>[]> caps(new std::atomic<long>[n]);
+  for (std::size_t i = 0; i < n; ++i) caps[i].store(LONG_MAX);
+  std::atomic<bool> stop_all{false};
+  std::vector<PlanningResult> results(n);
+  std::vector<PlanningStats> latest(n);
+  std::mutex lock;  // caps' updates, results, latest, the caller's progress
+  std::condition_variable finished;
+  std::size_t done = 0;
+
+  auto run = [&](std::size_t i) {
+    auto report = [&, i](const PlanningStats& s) {
+      std::lock_guard<std::mutex> hold(lock);
+      latest[i] = s;
+      if (progress) progress(combined(latest));
+    };
+    PlanningResult r = members[i]->search(&stop_all, report, &caps[i]);
+    std::lock_guard<std::mutex> hold(lock);
+    if (r.solved()) {
+      const long ni = r.stats.nodes_generated;
+      for (std::size_t j = 0; j < n; ++j) {
+        if (j == i) continue;
+        const long cap = j < i ? ni : ni - 1;  // an earlier member wins a tie
+        if (cap < caps[j].load()) caps[j].store(cap);
+      }
+    }
+    latest[i] = r.stats;
+    results[i] = std::move(r);
+    ++done;
+    finished.notify_all();
+  };
+  std::vector<std::thread> threads;
+  for (std::size_t i = 0; i < n; ++i) threads.emplace_back(run, i);
+  {
+    // The caller's cancel, passed on to every member.
+    std::unique_lock<std::mutex> hold(lock);
+    while (done < n) {
+      finished.wait_for(hold, std::chrono::milliseconds(50));
+      if (cancel && cancel->load()) stop_all = true;
+    }
+  }
+  for (auto& t : threads) t.join();
+
+  int winner = -1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (results[i].solved() &&
+        (winner < 0 || results[i].stats.nodes_generated < results[winner].stats.nodes_generated))
+      winner = static_cast<int>(i);
+  std::vector<PlanningResult::Member> outcomes;
+  for (std::size_t i = 0; i < n; ++i)
+    outcomes.push_back({names[i], results[i].status, results[i].reason, results[i].stats});
+  PlanningResult out;
+  if (winner >= 0) {
+    out = std::move(results[winner]);
+  } else {
+    // None solved: the first member's status (a cancel is every member's),
+    // every member's reason, their counts summed.
+    out.status = results[0].status;
+    for (std::size_t i = 0; i < n; ++i)
+      out.reason += (i ? "; " : "") + names[i] + ": " + results[i].reason;
+    out.stats = combined(latest);
+  }
+  out.members = std::move(outcomes);
+  out.winner = winner;
+  // The wall time the caller waited: every member stopped.
+  out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (winner >= 0) out.plan.stats.seconds = out.stats.seconds;
+  if (progress) progress(out.stats);
+  return out;
+}
+
+}  // namespace acyclic

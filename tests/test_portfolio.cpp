@@ -1,0 +1,235 @@
+// The planner's portfolio (PlannerParameters::portfolio): the plan of the
+// member that solves in the fewest nodes, the very plan that member makes
+// alone, whatever the members' speeds; a member that fails does not fail the
+// portfolio; a cancel reaches every member; verifiers are not shared at
+// once; the scenario's `planner: portfolio:` with named errors.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+#include <thread>
+
+#include "planner/common/format_error.h"
+#include "planner/search/planner_parameters.h"
+#include "test_support.h"
+
+using namespace acyclic;
+
+namespace {
+
+const Scenario& step() {
+  static Scenario sc = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml"));
+  return sc;
+}
+
+std::string json(const PlanningResult& r, const Scenario& sc) {
+  Plan p = r.plan;
+  p.stats.seconds = 0;
+  return planToJson(p, sc);
+}
+
+// Two settings under which step_forward is solved in different node counts.
+PlannerVariant asConfigured() { return {"as configured", {}}; }
+PlannerVariant coarser() {
+  return {"coarser", [](PlannerParameters& p) {
+            p.duplicate_distance = 0.15;
+            p.alternative_step = 0.05;
+          }};
+}
+
+}  // namespace
+
+TEST(Portfolio, TheMemberWithTheFewestNodesWinsWithThePlanItMakesAlone) {
+  const Scenario& sc = step();
+  PlannerParameters a, b;
+  coarser().apply(b);
+  const PlanningResult alone_a = ContactPlanner(sc, a).plan();
+  const PlanningResult alone_b = ContactPlanner(sc, b).plan();
+  ASSERT_TRUE(alone_a.solved() && alone_b.solved());
+  const long na = alone_a.stats.nodes_generated, nb = alone_b.stats.nodes_generated;
+  ASSERT_NE(na, nb) << "the two settings must differ for this test to mean anything";
+  const std::string best = na < nb ? "as configured" : "coarser";
+  const std::string best_json = json(na < nb ? alone_a : alone_b, sc);
+  // In either order, several times: the same winner and plan.
+  for (int order = 0; order < 2; ++order) {
+    for (int repeat = 0; repeat < 2; ++repeat) {
+      PlannerParameters p;
+      p.portfolio = order == 0 ? std::vector<PlannerVariant>{asConfigured(), coarser()}
+                               : std::vector<PlannerVariant>{coarser(), asConfigured()};
+      const PlanningResult r = ContactPlanner(sc, p).plan();
+      ASSERT_TRUE(r.solved()) << r.reason;
+      ASSERT_EQ(r.members.size(), 2u);
+      ASSERT_GE(r.winner, 0);
+      EXPECT_EQ(r.members[r.winner].name, best);
+      EXPECT_EQ(json(r, sc), best_json);
+      EXPECT_EQ(r.stats.nodes_generated, std::min(na, nb));
+      // The loser either solved too (in its own count, before the winner
+      // did) or was stopped past the winner's count.
+      const PlanningResult::Member& loser = r.members[1 - r.winner];
+      if (loser.status == PlanningResult::Status::Solved) {
+        EXPECT_EQ(loser.stats.nodes_generated, std::max(na, nb));
+      } else {
+        EXPECT_EQ(loser.status, PlanningResult::Status::Cancelled);
+        EXPECT_NE(loser.reason.find("outrun"), std::string::npos) << loser.reason;
+        EXPECT_GE(loser.stats.nodes_generated, std::min(na, nb));
+      }
+      EXPECT_EQ(r.portfolioNodes(), r.members[0].stats.nodes_generated + r.members[1].stats.nodes_generated);
+    }
+  }
+}
+
+// A member that cannot win is stopped once another has solved and it is
+// past that count: here one whose every plan is refused, with budgets it
+// would otherwise run to the end of (alone: no solution at 37 nodes, the
+// winner solves in 20).
+TEST(Portfolio, AMemberPastTheWinnersCountIsStopped) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  p.portfolio = {asConfigured(), {"refusing", [](PlannerParameters& q) {
+                                    q.verify_transitions = true;
+                                    q.verify_plan = [](const Plan&, const std::atomic<bool>&) {
+                                      PlanVerdict v;
+                                      v.failed_from = 0, v.failed_to = 1, v.reason = "refused by the test";
+                                      return v;
+                                    };
+                                    q.max_nodes = 1000000;
+                                    q.max_posture_calls = 1000000;
+                                    q.max_seconds = 600;
+                                  }}};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 0);
+  EXPECT_EQ(r.members[1].status, PlanningResult::Status::Cancelled) << r.members[1].reason;
+  EXPECT_NE(r.members[1].reason.find("outrun"), std::string::npos) << r.members[1].reason;
+  EXPECT_GE(r.members[1].stats.nodes_generated, r.stats.nodes_generated);
+}
+
+TEST(Portfolio, OfTwoEqualMembersTheFirstWins) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  p.portfolio = {{"first", {}}, {"second", {}}};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 0);
+  EXPECT_EQ(json(r, sc), json(ContactPlanner(sc).plan(), sc));
+}
+
+TEST(Portfolio, AMemberThatFailsDoesNotFailThePortfolio) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  // With one contact at most, no stance leaves the start's two feet.
+  p.portfolio = {{"one contact", [](PlannerParameters& q) { q.max_contacts = 1; }}, asConfigured()};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 1);
+  EXPECT_NE(r.members[0].status, PlanningResult::Status::Solved);
+  // None solves: the reasons of both, by name.
+  p.portfolio = {{"one contact", [](PlannerParameters& q) { q.max_contacts = 1; }},
+                 {"also one contact", [](PlannerParameters& q) { q.max_contacts = 1; }}};
+  const PlanningResult none = ContactPlanner(sc, p).plan();
+  EXPECT_FALSE(none.solved());
+  EXPECT_EQ(none.winner, -1);
+  EXPECT_NE(none.reason.find("one contact: "), std::string::npos) << none.reason;
+  EXPECT_NE(none.reason.find("also one contact: "), std::string::npos) << none.reason;
+  EXPECT_TRUE(none.plan.stances.empty());
+}
+
+TEST(Portfolio, ACancelReachesEveryMember) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));
+  PlannerParameters p = plannerParameters(sc);
+  p.portfolio = {asConfigured(), coarser()};
+  std::atomic<bool> cancel{false};
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    cancel = true;
+  });
+  const PlanningResult r = ContactPlanner(sc, p).plan(&cancel);
+  stopper.join();
+  EXPECT_EQ(r.status, PlanningResult::Status::Cancelled);
+  ASSERT_EQ(r.members.size(), 2u);
+  for (const auto& m : r.members) EXPECT_EQ(m.status, PlanningResult::Status::Cancelled) << m.name;
+  EXPECT_LT(r.stats.seconds, 5.0);  // each stops at its next posture call's end, not at the budget
+}
+
+TEST(Portfolio, EachMemberVerifiesWithItsOwnVerifierOrOneAtATime) {
+  const Scenario& sc = step();
+  // A verifier that accepts every plan, and notes calls that overlap.
+  std::atomic<int> inside{0}, overlaps{0}, calls{0}, made{0};
+  auto accepting = [&](const Plan& plan, const std::atomic<bool>&) {
+    if (inside.fetch_add(1) > 0) ++overlaps;
+    ++calls;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    --inside;
+    PlanVerdict v;
+    v.transitions = static_cast<int>(plan.stances.size()) - 1;
+    return v;
+  };
+  PlannerParameters p;
+  p.verify_transitions = true;
+  p.verify_plan = accepting;
+  p.portfolio = {asConfigured(), coarser()};
+  PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_GE(calls.load(), 1);
+  EXPECT_EQ(overlaps.load(), 0);  // one shared verifier: one call at a time
+  // With a factory: one verifier per member.
+  p.make_verifier = [&] {
+    ++made;
+    return PlanVerifier(accepting);
+  };
+  r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(made.load(), 2);
+}
+
+TEST(Portfolio, TraceLinesNameTheirMember) {
+  const Scenario& sc = step();
+  std::mutex lock;
+  std::vector<std::string> lines;
+  PlannerParameters p;
+  p.trace = [&](const std::string& line) {
+    std::lock_guard<std::mutex> hold(lock);
+    lines.push_back(line);
+  };
+  p.portfolio = {asConfigured(), coarser()};
+  ASSERT_TRUE(ContactPlanner(sc, p).plan().solved());
+  ASSERT_FALSE(lines.empty());
+  for (const auto& l : lines)
+    EXPECT_TRUE(l.rfind("[as configured] ", 0) == 0 || l.rfind("[coarser] ", 0) == 0) << l;
+}
+
+TEST(Portfolio, ReadFromTheScenarioWithNamedErrors) {
+  test::TempDir dir;
+  const std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  const Scenario sc = Scenario::load(dir.write(
+      "a.yaml", text + "planner: {duplicate_distance: 0.06, portfolio: [{}, {name: coarse, duplicate_distance: 0.1, "
+                       "posture_distance_engine: convex}]}\n"));
+  const PlannerParameters p = plannerParameters(sc);
+  ASSERT_EQ(p.portfolio.size(), 2u);
+  EXPECT_EQ(p.portfolio[0].name, "member 1");
+  EXPECT_EQ(p.portfolio[1].name, "coarse");
+  PlannerParameters q = p;
+  p.portfolio[0].apply(q);
+  EXPECT_DOUBLE_EQ(q.duplicate_distance, 0.06);  // an empty member: as configured
+  EXPECT_EQ(q.posture.distance_engine, DistanceEngine::Fcl);
+  p.portfolio[1].apply(q);
+  EXPECT_DOUBLE_EQ(q.duplicate_distance, 0.1);
+  EXPECT_EQ(q.posture.distance_engine, DistanceEngine::Convex);
+  for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
+           {"planner: {portfolio: [{}]}\n", "planner.portfolio"},
+           {"planner: {portfolio: {a: 1}}\n", "planner.portfolio"},
+           {"planner: {portfolio: [{}, 3]}\n", "planner.portfolio[1]"},
+           {"planner: {portfolio: [{}, {max_nodes: 5}]}\n", "planner.portfolio[1].max_nodes"},
+           {"planner: {portfolio: [{}, {threads: 1}]}\n", "planner.portfolio[1].threads"},
+           {"planner: {portfolio: [{}, {duplicate_distance: -1}]}\n", "planner.portfolio[1].duplicate_distance"},
+           {"planner: {portfolio: [{name: a}, {name: a}]}\n", "planner.portfolio[1].name"},
+           {"planner: {portfolio: [{}, {portfolio: [{}, {}]}]}\n", "planner.portfolio[1].portfolio"}}) {
+    const Scenario s = Scenario::load(dir.write("c.yaml", text + bad));
+    try {
+      plannerParameters(s);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const FormatError& e) {
+      EXPECT_EQ(e.field(), field) << e.what();
+    }
+  }
+}
