@@ -104,6 +104,42 @@ TEST(Portfolio, AMemberPastTheWinnersCountIsStopped) {
   EXPECT_GE(r.members[1].stats.nodes_generated, r.stats.nodes_generated);
 }
 
+// While a member verifies a goal, a member past its count waits instead of
+// searching on (its core goes to the verifier); the goal accepted, it is
+// outrun. Here the refusing member is slowed (30 ms per expansion) and
+// the winner's verifier holds its plan for 5 s: without the wait the
+// refusing member ends its search meanwhile (no solution, 37 nodes in 1.8 s).
+TEST(Portfolio, AMemberPastAGoalBeingVerifiedWaitsForItsVerdict) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  p.verify_transitions = true;
+  p.verify_plan = [](const Plan& plan, const std::atomic<bool>& stop) {
+    for (int i = 0; i < 100 && !stop.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    PlanVerdict v;
+    v.transitions = static_cast<int>(plan.stances.size()) - 1;
+    return v;
+  };
+  p.portfolio = {asConfigured(), {"refusing, slowly", [](PlannerParameters& q) {
+                                    q.verify_plan = [](const Plan&, const std::atomic<bool>&) {
+                                      PlanVerdict v;
+                                      v.failed_from = 0, v.failed_to = 1, v.reason = "refused by the test";
+                                      return v;
+                                    };
+                                    q.trace = [](const std::string&) {
+                                      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+                                    };
+                                    q.max_nodes = 1000000;
+                                    q.max_posture_calls = 1000000;
+                                    q.max_seconds = 600;
+                                  }}};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 0);
+  EXPECT_EQ(r.members[1].status, PlanningResult::Status::Cancelled) << r.members[1].reason;
+  EXPECT_NE(r.members[1].reason.find("outrun"), std::string::npos) << r.members[1].reason;
+  EXPECT_LT(r.members[1].stats.nodes_generated, 37);
+}
+
 TEST(Portfolio, OfTwoEqualMembersTheFirstWins) {
   const Scenario& sc = step();
   PlannerParameters p;

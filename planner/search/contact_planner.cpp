@@ -147,6 +147,7 @@ struct ContactPlanner::Impl {
   std::vector<char> stance_settled;  // exportPlan: the stance is a settledWitness (its owner's settled_used)
   ContactPlanner::Progress progress;  // the caller's, also told when a verification starts
   const std::atomic<bool>* cancel = nullptr;  // checked before every posture call
+  ContactPlanner::MemberLink* link = nullptr;  // as a member of a portfolio
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
 
@@ -176,7 +177,19 @@ struct ContactPlanner::Impl {
   }
   double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
+  // A portfolio's member past the count another solved in cannot win.
+  bool outrun(long nodes) const { return link && link->outrun(nodes); }
+  void stopOutrun() {
+    stop = PlanningResult::Status::Cancelled;
+    stop_reason = "outrun: another member of the portfolio solved, and this one is past " +
+                  std::to_string(link->cap()) + " nodes";
+  }
+
   bool budgetLeft() {
+    if (outrun(stats.nodes_generated)) {
+      stopOutrun();
+      return false;
+    }
     if (cancel && cancel->load()) {
       stop = PlanningResult::Status::Cancelled;
       stop_reason = "cancelled";
@@ -855,9 +868,10 @@ struct ContactPlanner::Impl {
       stats.verifying = false;
     }
     std::atomic<bool> stop_flag{false}, done{false};
+    const long nodes_now = stats.nodes_generated;
     std::thread watch([&] {
       while (!done.load()) {
-        if ((cancel && cancel->load()) || elapsed() > p.max_seconds) stop_flag = true;
+        if ((cancel && cancel->load()) || elapsed() > p.max_seconds || outrun(nodes_now)) stop_flag = true;
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
     });
@@ -897,7 +911,7 @@ struct ContactPlanner::Impl {
       const PlanVerdict v = verify(plan, goal);
       if (v.ok()) return Verified::Ok;
       if (v.stopped) {
-        budgetLeft();  // the stop's reason: cancel or a budget
+        budgetLeft();  // the stop's reason: outrun, cancel or a budget
         if (stop == PlanningResult::Status::NoSolution) stop = PlanningResult::Status::TimeLimit;
         stop_reason = std::string(goal ? "a plan of " + std::to_string(plan.stances.size()) +
                                              " stances was found but its transitions were not all verified: "
@@ -952,9 +966,9 @@ PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progr
   return portfolio_ ? portfolio_->plan(cancel, progress) : search(cancel, progress, nullptr);
 }
 
-PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Progress& progress,
-                                      const std::atomic<long>* node_cap) {
+PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Progress& progress, MemberLink* link) {
   Impl& I = *impl_;
+  I.link = link;
   I.t0 = std::chrono::steady_clock::now();
   I.cancel = cancel;
   I.progress = progress;
@@ -975,23 +989,26 @@ PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Pro
   Plan plan;
   bool exported = false;
   while (true) {
-    if (node_cap && I.stats.nodes_generated > node_cap->load()) {
-      // Checked here only, where a search alone would check its goal: up to
-      // this point the search is the one it makes alone (portfolio.h).
-      I.stop = PlanningResult::Status::Cancelled;
-      I.stop_reason = "outrun: another member of the portfolio solved, and this one is past " +
-                      std::to_string(node_cap->load()) + " nodes";
-      break;
+    if (link) {
+      // While another member verifies a goal this one cannot beat, its
+      // core is the verifier's (waiting changes nothing in this search).
+      link->gate(I.stats.nodes_generated, [&] { return (cancel && cancel->load()) || I.elapsed() > I.p.max_seconds; });
+      if (I.outrun(I.stats.nodes_generated)) {
+        I.stopOutrun();
+        break;
+      }
     }
     if (I.goal_node >= 0) {
       // A goal whose plan cannot be exported (a settled stance without a
       // valid witness) or whose transitions cannot all be made is dropped
       // with the node where it fails; the search goes on.
+      if (link) link->verifying(I.stats.nodes_generated);
       const Impl::Verified v = I.verifyPath(I.goal_node, plan, out, true);
       if (v == Impl::Verified::Ok) {
-        exported = true;
+        exported = true;  // still "verifying" for the others until the portfolio sets their caps
         break;
       }
+      if (link) link->verifying(-1);
       if (v == Impl::Verified::Stopped) break;
       I.goal_node = -1;
     }

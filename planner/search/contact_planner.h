@@ -211,12 +211,13 @@ class ContactPlanner {
   PlanningResult plan(const std::atomic<bool>* cancel = nullptr, const Progress& progress = {});
 
  private:
-  struct Impl;       // one search
-  struct Portfolio;  // one ContactPlanner per member (portfolio.h)
-  // One search; it stops (Cancelled) at the top of its loop once it has
-  // generated more than *node_cap nodes.
-  PlanningResult search(const std::atomic<bool>* cancel, const Progress& progress,
-                        const std::atomic<long>* node_cap);
+  struct Impl;        // one search
+  struct Portfolio;   // one ContactPlanner per member (portfolio.h)
+  struct MemberLink;  // a member's view of its portfolio (portfolio.h)
+  // One search; as a member of a portfolio (link), it stops (Cancelled)
+  // once it has generated more nodes than another member solved in, and
+  // waits while another verifies a goal it cannot beat.
+  PlanningResult search(const std::atomic<bool>* cancel, const Progress& progress, MemberLink* link);
   std::unique_ptr<Impl> impl_;            // without a portfolio
   std::unique_ptr<Portfolio> portfolio_;  // with one
 };

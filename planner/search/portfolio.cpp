@@ -45,6 +45,41 @@ PlanningStats combined(const std::vector<PlanningStats>& all) {
 
 }  // namespace
 
+struct PortfolioState {
+  std::mutex lock;
+  std::condition_variable changed;  // a cap lowered, a verification ended, a member finished
+  std::vector<long> caps, goals;    // goals: the count of a goal being verified, LONG_MAX: none
+  explicit PortfolioState(std::size_t n) : caps(n, LONG_MAX), goals(n, LONG_MAX) {}
+  // Member j's bound from member i's count n: an earlier member wins a tie.
+  static long bound(std::size_t j, std::size_t i, long n) { return n == LONG_MAX ? LONG_MAX : j < i ? n : n - 1; }
+};
+
+long ContactPlanner::MemberLink::cap() const {
+  std::lock_guard<std::mutex> hold(state->lock);
+  return state->caps[index];
+}
+
+void ContactPlanner::MemberLink::verifying(long nodes) {
+  {
+    std::lock_guard<std::mutex> hold(state->lock);
+    state->goals[index] = nodes < 0 ? LONG_MAX : nodes;
+  }
+  state->changed.notify_all();
+}
+
+void ContactPlanner::MemberLink::gate(long nodes, const std::function<bool()>& give_up) {
+  std::unique_lock<std::mutex> hold(state->lock);
+  auto beaten = [&] {
+    for (std::size_t i = 0; i < state->goals.size(); ++i)
+      if (i != index && nodes > PortfolioState::bound(index, i, state->goals[i])) return true;
+    return false;
+  };
+  while (beaten() && nodes <= state->caps[index]) {
+    state->changed.wait_for(hold, std::chrono::milliseconds(50));
+    if (give_up()) return;
+  }
+}
+
 ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerParameters& params) {
   const int n = static_cast<int>(params.portfolio.size());
   // Shared by the members when there is no factory of verifiers, and for
@@ -56,21 +91,20 @@ ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerPara
       if (other == v.name) throw std::invalid_argument("portfolio: two members named \"" + v.name + "\"");
     PlannerParameters p = params;
     p.portfolio.clear();
+    // The verifier before the member's changes, so that a member may bring its own.
+    if (p.make_verifier) {
+      p.verify_plan = p.make_verifier();
+    } else if (p.verify_plan) {
+      PlanVerifier shared = p.verify_plan;
+      p.verify_plan = [verify_lock, shared](const Plan& plan, const std::atomic<bool>& stop) {
+        std::lock_guard<std::mutex> hold(*verify_lock);
+        return shared(plan, stop);
+      };
+    }
     if (v.apply) v.apply(p);
     if (!p.portfolio.empty())
       throw std::invalid_argument("portfolio member \"" + v.name + "\": a member cannot hold a portfolio");
     p.threads = std::max(1, params.threads / n);
-    if (p.verify_transitions) {
-      if (p.make_verifier) {
-        p.verify_plan = p.make_verifier();
-      } else if (p.verify_plan) {
-        PlanVerifier shared = p.verify_plan;
-        p.verify_plan = [verify_lock, shared](const Plan& plan, const std::atomic<bool>& stop) {
-          std::lock_guard<std::mutex> hold(*verify_lock);
-          return shared(plan, stop);
-        };
-      }
-    }
     if (p.trace) {
       auto trace = p.trace;
       const std::string prefix = "[" + v.name + "] ";
@@ -87,43 +121,41 @@ ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerPara
 PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, const Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = members.size();
-  std::unique_ptr<std::atomic<long>[]> caps(new std::atomic<long>[n]);
-  for (std::size_t i = 0; i < n; ++i) caps[i].store(LONG_MAX);
+  PortfolioState state(n);
   std::atomic<bool> stop_all{false};
   std::vector<PlanningResult> results(n);
   std::vector<PlanningStats> latest(n);
-  std::mutex lock;  // caps' updates, results, latest, the caller's progress
-  std::condition_variable finished;
-  std::size_t done = 0;
+  std::mutex report_lock;  // latest, the caller's progress
+  std::size_t done = 0;    // under state.lock
 
   auto run = [&](std::size_t i) {
     auto report = [&, i](const PlanningStats& s) {
-      std::lock_guard<std::mutex> hold(lock);
+      std::lock_guard<std::mutex> hold(report_lock);
       latest[i] = s;
       if (progress) progress(combined(latest));
     };
-    PlanningResult r = members[i]->search(&stop_all, report, &caps[i]);
-    std::lock_guard<std::mutex> hold(lock);
-    if (r.solved()) {
-      const long ni = r.stats.nodes_generated;
-      for (std::size_t j = 0; j < n; ++j) {
-        if (j == i) continue;
-        const long cap = j < i ? ni : ni - 1;  // an earlier member wins a tie
-        if (cap < caps[j].load()) caps[j].store(cap);
-      }
+    MemberLink link{&state, i};
+    PlanningResult r = members[i]->search(&stop_all, report, &link);
+    {
+      std::lock_guard<std::mutex> hold(state.lock);
+      if (r.solved())
+        for (std::size_t j = 0; j < n; ++j)
+          if (j != i) state.caps[j] = std::min(state.caps[j], PortfolioState::bound(j, i, r.stats.nodes_generated));
+      state.goals[i] = LONG_MAX;
+      ++done;
     }
+    state.changed.notify_all();
+    std::lock_guard<std::mutex> hold(report_lock);
     latest[i] = r.stats;
     results[i] = std::move(r);
-    ++done;
-    finished.notify_all();
   };
   std::vector<std::thread> threads;
   for (std::size_t i = 0; i < n; ++i) threads.emplace_back(run, i);
   {
     // The caller's cancel, passed on to every member.
-    std::unique_lock<std::mutex> hold(lock);
+    std::unique_lock<std::mutex> hold(state.lock);
     while (done < n) {
-      finished.wait_for(hold, std::chrono::milliseconds(50));
+      state.changed.wait_for(hold, std::chrono::milliseconds(50));
       if (cancel && cancel->load()) stop_all = true;
     }
   }
