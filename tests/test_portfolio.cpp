@@ -140,6 +140,46 @@ TEST(Portfolio, AMemberPastAGoalBeingVerifiedWaitsForItsVerdict) {
   EXPECT_LT(r.members[1].stats.nodes_generated, 37);
 }
 
+// A member verifying a goal stops when another starts verifying a better
+// one (here the same count, found by the earlier member, which wins ties):
+// only the better goal's verification runs. The earlier member is slowed
+// (30 ms per expansion) so that the later one starts verifying first; each
+// verifier holds a plan for 5 s unless stopped.
+TEST(Portfolio, AVerificationOfABeatenGoalIsDeferred) {
+  const Scenario& sc = step();
+  std::mutex lock;
+  std::vector<double> held;  // seconds each verifier call held, by member
+  int made = 0;
+  PlannerParameters p;
+  p.verify_transitions = true;
+  p.make_verifier = [&] {
+    std::lock_guard<std::mutex> hold(lock);
+    const int member = made++;
+    if (held.size() < 2) held.resize(2, 0.0);
+    return PlanVerifier([&, member](const Plan& plan, const std::atomic<bool>& stop) {
+      const auto t0 = std::chrono::steady_clock::now();
+      PlanVerdict v;
+      v.transitions = static_cast<int>(plan.stances.size()) - 1;
+      for (int i = 0; i < 100 && !stop.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      v.stopped = stop.load();
+      std::lock_guard<std::mutex> hold(lock);
+      held[member] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      return v;
+    });
+  };
+  p.portfolio = {{"slowed", [](PlannerParameters& q) {
+                    q.trace = [](const std::string&) { std::this_thread::sleep_for(std::chrono::milliseconds(30)); };
+                  }},
+                 asConfigured()};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 0);
+  EXPECT_EQ(r.members[1].status, PlanningResult::Status::Cancelled) << r.members[1].reason;
+  ASSERT_EQ(held.size(), 2u);
+  EXPECT_GT(held[0], 4.5);  // the winner's verification ran whole
+  EXPECT_LT(held[1], 3.0);  // the other's was stopped when the winner's began
+}
+
 TEST(Portfolio, OfTwoEqualMembersTheFirstWins) {
   const Scenario& sc = step();
   PlannerParameters p;

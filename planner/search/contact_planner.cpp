@@ -872,6 +872,8 @@ struct ContactPlanner::Impl {
     std::thread watch([&] {
       while (!done.load()) {
         if ((cancel && cancel->load()) || elapsed() > p.max_seconds || outrun(nodes_now)) stop_flag = true;
+        // A portfolio's member beaten by a goal another verifies defers its own (verifyPath).
+        if (announce && link && link->beaten(nodes_now)) stop_flag = true;
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
     });
@@ -900,7 +902,10 @@ struct ContactPlanner::Impl {
   // motion starts). Transitions solved once are remembered by the verifier.
   // Refused goals are recorded in `out` (`goal`); a stop (cancel or budget)
   // during verification sets the stop's reason.
-  enum class Verified { Ok, Dropped, Stopped };
+  // Deferred: a portfolio's member stopped verifying its goal because
+  // another verifies a better one; the goal is verified again after that
+  // one's verdict, unless it was accepted.
+  enum class Verified { Ok, Dropped, Stopped, Deferred };
   Verified verifyPath(int node, Plan& plan, PlanningResult& out, bool goal) {
     while (true) {
       if (!exportPlan(node, plan)) {
@@ -910,6 +915,7 @@ struct ContactPlanner::Impl {
       if (!p.verify_transitions) return Verified::Ok;
       const PlanVerdict v = verify(plan, goal);
       if (v.ok()) return Verified::Ok;
+      if (v.stopped && goal && budgetLeft() && link && link->beaten(stats.nodes_generated)) return Verified::Deferred;
       if (v.stopped) {
         budgetLeft();  // the stop's reason: outrun, cancel or a budget
         if (stop == PlanningResult::Status::NoSolution) stop = PlanningResult::Status::TimeLimit;
@@ -1010,6 +1016,7 @@ PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Pro
       }
       if (link) link->verifying(-1);
       if (v == Impl::Verified::Stopped) break;
+      if (v == Impl::Verified::Deferred) continue;  // to the gate, then verified again or outrun
       I.goal_node = -1;
     }
     if (!I.budgetLeft()) break;

@@ -52,6 +52,8 @@ struct PortfolioState {
   explicit PortfolioState(std::size_t n) : caps(n, LONG_MAX), goals(n, LONG_MAX) {}
   // Member j's bound from member i's count n: an earlier member wins a tie.
   static long bound(std::size_t j, std::size_t i, long n) { return n == LONG_MAX ? LONG_MAX : j < i ? n : n - 1; }
+  // Another member than j verifies a goal j, at `nodes`, cannot beat (under lock).
+  bool beaten(std::size_t j, long nodes) const;
 };
 
 long ContactPlanner::MemberLink::cap() const {
@@ -67,14 +69,20 @@ void ContactPlanner::MemberLink::verifying(long nodes) {
   state->changed.notify_all();
 }
 
+bool PortfolioState::beaten(std::size_t j, long nodes) const {
+  for (std::size_t i = 0; i < goals.size(); ++i)
+    if (i != j && nodes > bound(j, i, goals[i])) return true;
+  return false;
+}
+
+bool ContactPlanner::MemberLink::beaten(long nodes) const {
+  std::lock_guard<std::mutex> hold(state->lock);
+  return state->beaten(index, nodes);
+}
+
 void ContactPlanner::MemberLink::gate(long nodes, const std::function<bool()>& give_up) {
   std::unique_lock<std::mutex> hold(state->lock);
-  auto beaten = [&] {
-    for (std::size_t i = 0; i < state->goals.size(); ++i)
-      if (i != index && nodes > PortfolioState::bound(index, i, state->goals[i])) return true;
-    return false;
-  };
-  while (beaten() && nodes <= state->caps[index]) {
+  while (state->beaten(index, nodes) && nodes <= state->caps[index]) {
     state->changed.wait_for(hold, std::chrono::milliseconds(50));
     if (give_up()) return;
   }

@@ -14,7 +14,10 @@
 // While member i verifies the transitions of a goal found at count g_i, a
 // member j whose count is already past that (tie-adjusted) waits at the top
 // of its loop: if i's plan is accepted j is outrun, if refused j goes on as
-// if it had not waited. Its core goes to i's verifier meanwhile.
+// if it had not waited. Its core goes to i's verifier meanwhile. If j was
+// itself verifying a goal, it stops that verification and verifies again
+// after i's verdict (the transitions it solved are remembered by its
+// verifier), so that only the better goal's verification runs.
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -35,6 +38,9 @@ struct ContactPlanner::MemberLink {
   bool outrun(long nodes) const { return nodes > cap(); }
   // A goal found at this count is being verified (-1: no longer).
   void verifying(long nodes);
+  // Another member verifies a goal found at a count this one, at `nodes`,
+  // cannot beat.
+  bool beaten(long nodes) const;
   // Waits while another member verifies a goal found at a count this one,
   // at `nodes`, cannot beat; `give_up` (polled) ends the wait early.
   void gate(long nodes, const std::function<bool()>& give_up);
