@@ -100,13 +100,11 @@ int main(int argc, char** argv) {
     loaded = Scenario::load(path);
     shipped = plannerParameters(loaded);
     if (!member.empty()) {
-      const auto m = std::find_if(shipped.portfolio.begin(), shipped.portfolio.end(),
-                                  [&](const PlannerVariant& v) { return v.name == member; });
-      if (m == shipped.portfolio.end())
-        throw std::invalid_argument(path + ": --member " + member + ": no such member in planner.portfolio");
-      const PlannerVariant alone = *m;
-      shipped.portfolio.clear();
-      if (alone.apply) alone.apply(shipped);
+      try {
+        keepPortfolioMember(shipped, member);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(path + ": --member: " + e.what());
+      }
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_sensitivity: %s\n", e.what());

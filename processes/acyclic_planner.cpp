@@ -46,7 +46,11 @@ int main(int argc, char** argv) {
   app.add_option("--max-nodes", o.max_nodes, "nodes generated at most (default: scenario, else 1000)");
   app.add_option("--max-posture-calls", o.max_posture_calls, "posture-generator calls at most (default: scenario, else 20000)");
   app.add_option("--threads", o.threads,
-                 "posture generators run at once (default: scenario, else 2); the plan does not depend on it");
+                 "posture generators run at once, shared among the scenario's portfolio members (default: "
+                 "scenario, else 2); the plan does not depend on it");
+  app.add_option("--member", o.member,
+                 "of the scenario's portfolio (planner: portfolio), plan with this member alone, on every thread "
+                 "(default: the whole portfolio; its plan is the winning member's)");
   app.add_flag("--eager-sons", o.eager_sons, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
   app.add_flag("--random-candidates", o.random_candidates,
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");

@@ -17,6 +17,7 @@ struct PlannerOverrides {
   int verify_transitions = -1;  // -1: the scenario's (planner: verify_transitions), 0 off, 1 on
   int verify_on_expansion = -1;  // -1: the scenario's (planner: verify_on_expansion), 0 off, 1 on
   bool verbose = false;  // one line per expanded node on stderr
+  std::string member;    // of the scenario's portfolio, planned alone (empty: the whole portfolio)
   // The scenario's parameters with these overrides; a request's time budget
   // (> 0) applies unless --max-seconds is given. Also sets sc.seed. With
   // verify_transitions, the interpolator's verifier (built only with it).

@@ -123,4 +123,17 @@ TEST(AcyclicPlanner, APortfolioWritesItsWinnersPlanAndSaysEachMembersOutcome) {
   };
   EXPECT_FALSE(stances(dir.path() + "/both.json").empty());
   EXPECT_EQ(stances(dir.path() + "/both.json"), stances(dir.path() + "/alone.json"));
+  // --member: one member alone, as its own scenario plans.
+  const std::string winner = fine_won ? "fine" : "coarse";
+  const auto m = plan(both, dir.path() + "/member.json", "--member " + winner);
+  ASSERT_EQ(m.status, 0) << m.output;
+  EXPECT_EQ(m.output.find("portfolio member"), std::string::npos) << m.output;
+  EXPECT_EQ(stances(dir.path() + "/member.json"), stances(dir.path() + "/alone.json"));
+  const auto other = plan(both, dir.path() + "/other.json", std::string("--member ") + (fine_won ? "coarse" : "fine"));
+  ASSERT_EQ(other.status, 0) << other.output;
+  EXPECT_NE(stances(dir.path() + "/other.json"), stances(dir.path() + "/alone.json"));
+  const auto none = plan(both, dir.path() + "/none.json", "--member nope");
+  EXPECT_EQ(none.status, 2) << none.output;
+  EXPECT_NE(none.output.find("its members: fine, coarse"), std::string::npos) << none.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/none.json"));
 }

@@ -1,5 +1,7 @@
 #include "planner/search/planner_parameters.h"
 
+#include <stdexcept>
+
 #include "planner/scene/friction.h"
 
 namespace acyclic {
@@ -148,6 +150,23 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   readFields(f, p);
   if (f.has("portfolio")) p.portfolio = portfolioOf(f["portfolio"], p);
   return p;
+}
+
+void keepPortfolioMember(PlannerParameters& p, const std::string& name) {
+  std::string names;
+  for (const PlannerVariant& v : p.portfolio) {
+    if (v.name != name) {
+      names += (names.empty() ? "" : ", ") + v.name;
+      continue;
+    }
+    const PlannerVariant member = v;
+    p.portfolio.clear();
+    if (member.apply) member.apply(p);
+    return;
+  }
+  throw std::invalid_argument("no portfolio member named \"" + name + "\" (" +
+                              (names.empty() ? std::string("the scenario has no portfolio") : "its members: " + names) +
+                              ")");
 }
 
 }  // namespace acyclic

@@ -8,4 +8,9 @@ namespace acyclic {
 // the file and field on a bad value or an unknown name).
 PlannerParameters plannerParameters(const Scenario& sc);
 
+// p's portfolio member of that name applied to p, and the portfolio
+// dropped: that member planned alone, on all of p's threads
+// (std::invalid_argument naming the members when there is no such one).
+void keepPortfolioMember(PlannerParameters& p, const std::string& name);
+
 }  // namespace acyclic
