@@ -44,7 +44,12 @@ TransitionVerifier::TransitionVerifier(const Scenario& sc, const InterpolatorOpt
     solvers_.push_back(std::make_unique<TransitionSolver>(*sc_, options_));
 }
 
-PlanVerdict TransitionVerifier::verify(const Plan& plan, const std::atomic<bool>& stop) {
+PlanVerdict TransitionVerifier::verify(const Plan& found, const std::atomic<bool>& stop) {
+  // The plan as the interpolator will read it from the planner's file: the
+  // JSON round trip normalizes the base's quaternion, and a last bit is
+  // enough to change the outcome of a solve at the margins (a plan accepted
+  // in memory failed to interpolate from its file).
+  const Plan plan = planFromJson(planToJson(found, *sc_), "the plan being verified", *sc_);
   PlanVerdict v;
   std::vector<int> kept;
   for (int k = 0; k < static_cast<int>(plan.stances.size()); ++k) kept.push_back(k);
