@@ -4,7 +4,8 @@
 // transition of a plan the search found is solved as the interpolator will
 // solve it (same designs, every stance kept, same options), and the first
 // that cannot be made is reported, so that the search drops the stance it
-// leads to and goes on. A plan it accepts interpolates with those options.
+// leads to and goes on. A plan it accepts interpolates with those options:
+// it is verified as its file holds it (written to JSON and read back).
 //
 // Transitions depend only on their stances: the outcome of each is
 // remembered, keyed by the stances' exact contents, so a plan that shares a
