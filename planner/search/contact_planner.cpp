@@ -148,6 +148,7 @@ struct ContactPlanner::Impl {
   ContactPlanner::Progress progress;  // the caller's, also told when a verification starts
   const std::atomic<bool>* cancel = nullptr;  // checked before every posture call
   ContactPlanner::MemberLink* link = nullptr;  // as a member of a portfolio
+  bool deferred = false;  // the last verification was stopped for a better goal another member verifies
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
 
@@ -867,13 +868,13 @@ struct ContactPlanner::Impl {
       progress(stats);
       stats.verifying = false;
     }
-    std::atomic<bool> stop_flag{false}, done{false};
+    std::atomic<bool> stop_flag{false}, done{false}, beaten{false};
     const long nodes_now = stats.nodes_generated;
     std::thread watch([&] {
       while (!done.load()) {
         if ((cancel && cancel->load()) || elapsed() > p.max_seconds || outrun(nodes_now)) stop_flag = true;
         // A portfolio's member beaten by a goal another verifies defers its own (verifyPath).
-        if (announce && link && link->beaten(nodes_now)) stop_flag = true;
+        if (announce && link && link->beaten(nodes_now)) beaten = stop_flag = true;
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
     });
@@ -887,7 +888,8 @@ struct ContactPlanner::Impl {
     }
     done = true;
     watch.join();
-    if (announce) ++stats.plans_verified;
+    deferred = v.stopped && beaten.load();
+    if (announce && !deferred) ++stats.plans_verified;
     stats.transitions_solved += v.solved;
     stats.verify_seconds += elapsed() - start;
     return v;
@@ -915,7 +917,7 @@ struct ContactPlanner::Impl {
       if (!p.verify_transitions) return Verified::Ok;
       const PlanVerdict v = verify(plan, goal);
       if (v.ok()) return Verified::Ok;
-      if (v.stopped && goal && budgetLeft() && link && link->beaten(stats.nodes_generated)) return Verified::Deferred;
+      if (deferred && budgetLeft()) return Verified::Deferred;
       if (v.stopped) {
         budgetLeft();  // the stop's reason: outrun, cancel or a budget
         if (stop == PlanningResult::Status::NoSolution) stop = PlanningResult::Status::TimeLimit;

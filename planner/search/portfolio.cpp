@@ -100,7 +100,7 @@ ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerPara
     PlannerParameters p = params;
     p.portfolio.clear();
     // The verifier before the member's changes, so that a member may bring its own.
-    if (p.make_verifier) {
+    if (p.verify_transitions && p.make_verifier) {
       p.verify_plan = p.make_verifier();
     } else if (p.verify_plan) {
       PlanVerifier shared = p.verify_plan;
