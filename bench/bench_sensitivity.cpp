@@ -124,14 +124,13 @@ int main(int argc, char** argv) {
     if (max_nodes > 0) p.max_nodes = max_nodes;
     p.threads = threads;
     if (v.scenario) v.scenario(sc);
-    if (v.params) {
-      if (!portfolio) v.params(p);
+    if (v.params && !portfolio) v.params(p);
+    if (v.params && portfolio)
       for (PlannerVariant& m : p.portfolio)  // each member perturbed after its own changes
         m.apply = [own = m.apply, perturb = v.params](PlannerParameters& q) {
           if (own) own(q);
           perturb(q);
         };
-    }
     const PlanningResult r = ContactPlanner(sc, p).plan();
     std::printf("%-22s %-16s %7ld %9.2f", v.name.c_str(), toString(r.status), r.stats.nodes_generated,
                 r.stats.seconds);

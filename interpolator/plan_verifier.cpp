@@ -123,12 +123,12 @@ PlanVerifier makePlanVerifier(const Scenario& sc, const InterpolatorOptions& opt
 
 void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options) {
   if (!p.verify_transitions) return;
-  if (!p.verify_plan) p.verify_plan = makePlanVerifier(sc, options);
   if (!p.make_verifier) {
     // A portfolio's members each get their own (PlannerParameters::make_verifier).
     auto scenario = std::make_shared<const Scenario>(sc);
     p.make_verifier = [scenario, options] { return makePlanVerifier(*scenario, options); };
   }
+  if (!p.verify_plan) p.verify_plan = p.make_verifier();
 }
 
 void attachPlanVerifier(PlannerParameters& p, const Scenario& sc) {

@@ -37,6 +37,25 @@ PlannerVariant coarser() {
           }};
 }
 
+// A member whose verifier refuses every plan, with budgets it would run to
+// the end of: it cannot solve, only be outrun (or run out of stances).
+void refuseEveryPlan(PlannerParameters& q) {
+  q.verify_transitions = true;
+  q.verify_plan = [](const Plan&, const std::atomic<bool>&) {
+    PlanVerdict v;
+    v.failed_from = 0, v.failed_to = 1, v.reason = "refused by the test";
+    return v;
+  };
+  q.max_nodes = 1000000;
+  q.max_posture_calls = 1000000;
+  q.max_seconds = 600;
+}
+
+// 30 ms more per expansion (its trace is called once per expanded node).
+void slowDown(PlannerParameters& q) {
+  q.trace = [](const std::string&) { std::this_thread::sleep_for(std::chrono::milliseconds(30)); };
+}
+
 }  // namespace
 
 TEST(Portfolio, TheMemberWithTheFewestNodesWinsWithThePlanItMakesAlone) {
@@ -85,17 +104,7 @@ TEST(Portfolio, TheMemberWithTheFewestNodesWinsWithThePlanItMakesAlone) {
 TEST(Portfolio, AMemberPastTheWinnersCountIsStopped) {
   const Scenario& sc = step();
   PlannerParameters p;
-  p.portfolio = {asConfigured(), {"refusing", [](PlannerParameters& q) {
-                                    q.verify_transitions = true;
-                                    q.verify_plan = [](const Plan&, const std::atomic<bool>&) {
-                                      PlanVerdict v;
-                                      v.failed_from = 0, v.failed_to = 1, v.reason = "refused by the test";
-                                      return v;
-                                    };
-                                    q.max_nodes = 1000000;
-                                    q.max_posture_calls = 1000000;
-                                    q.max_seconds = 600;
-                                  }}};
+  p.portfolio = {asConfigured(), {"refusing", refuseEveryPlan}};
   const PlanningResult r = ContactPlanner(sc, p).plan();
   ASSERT_TRUE(r.solved()) << r.reason;
   EXPECT_EQ(r.winner, 0);
@@ -120,17 +129,8 @@ TEST(Portfolio, AMemberPastAGoalBeingVerifiedWaitsForItsVerdict) {
     return v;
   };
   p.portfolio = {asConfigured(), {"refusing, slowly", [](PlannerParameters& q) {
-                                    q.verify_plan = [](const Plan&, const std::atomic<bool>&) {
-                                      PlanVerdict v;
-                                      v.failed_from = 0, v.failed_to = 1, v.reason = "refused by the test";
-                                      return v;
-                                    };
-                                    q.trace = [](const std::string&) {
-                                      std::this_thread::sleep_for(std::chrono::milliseconds(30));
-                                    };
-                                    q.max_nodes = 1000000;
-                                    q.max_posture_calls = 1000000;
-                                    q.max_seconds = 600;
+                                    refuseEveryPlan(q);
+                                    slowDown(q);
                                   }}};
   const PlanningResult r = ContactPlanner(sc, p).plan();
   ASSERT_TRUE(r.solved()) << r.reason;
@@ -167,10 +167,7 @@ TEST(Portfolio, AVerificationOfABeatenGoalIsDeferred) {
       return v;
     });
   };
-  p.portfolio = {{"slowed", [](PlannerParameters& q) {
-                    q.trace = [](const std::string&) { std::this_thread::sleep_for(std::chrono::milliseconds(30)); };
-                  }},
-                 asConfigured()};
+  p.portfolio = {{"slowed", slowDown}, asConfigured()};
   const PlanningResult r = ContactPlanner(sc, p).plan();
   ASSERT_TRUE(r.solved()) << r.reason;
   EXPECT_EQ(r.winner, 0);
