@@ -178,3 +178,32 @@ TEST(GuidePotential, RejectsGuidesThatAreNotOneToOne) {
   EXPECT_THROW(GuidePotential({sc.start}, 1.0, 0.05), std::invalid_argument);
   EXPECT_THROW(GuidePotential({sc.start, sc.start}, 1.0, 0.05), std::invalid_argument);
 }
+
+TEST(GuidePotential, ProjectsOnTheNearestPointOfTheWholeGuide) {
+  // chair_paper's hand-written guide: many corners, so many blends, most of
+  // them far from any one point and left unsearched by project (their
+  // bounding balls are farther than the nearest segment). The projection
+  // must still be the nearest point of all of T', sampled densely here.
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
+  const GuidePotential f(sc.key_postures, 1.0, 0.05);
+  ASSERT_GE(f.junctions().size(), 8u);
+  std::vector<Eigen::VectorXd> samples;
+  for (int i = 0; i <= 20000; ++i) samples.push_back(f.pointAt(f.length() * i / 20000).head(6));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> along(0, f.length());
+  std::normal_distribution<double> n(0, 1);
+  int near_a_blend = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Eigen::VectorXd P = f.pointAt(along(rng));
+    for (int i = 0; i < 6; ++i) P[i] += 0.04 * n(rng);
+    const GuidePotential::Projection pr = f.project(P);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& c : samples) nearest = std::min(nearest, (c - P.head(6)).squaredNorm());
+    const double d = (pr.Q.head(6) - P.head(6)).squaredNorm();
+    EXPECT_LE(d, nearest + 1e-9) << "trial " << trial;
+    const std::vector<double> j = f.junctions();
+    for (std::size_t k = 0; k + 1 < j.size(); k += 2)
+      if (pr.s > j[k] && pr.s < j[k + 1]) ++near_a_blend;
+  }
+  EXPECT_GT(near_a_blend, 30);  // the blends were searched where they are nearest
+}

@@ -73,6 +73,10 @@ class GuidePotential : public PostureCost {
     // rest coordinates (joints): values and slopes at the piece's ends
     Eigen::VectorXd r0, r1, m0, m1;
     Eigen::VectorXd V;            // blend: the corner
+    // blend: a ball around its control points; the curve lies in their
+    // convex hull, so in the ball (project's lower bound)
+    Eigen::VectorXd centre;
+    double radius = 0;
   };
   double valueAndGradient(const Eigen::VectorXd& P, Eigen::VectorXd* grad) const;
   Eigen::VectorXd basePoint(const Piece& p, double tau, int derivative) const;
