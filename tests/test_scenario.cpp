@@ -195,6 +195,31 @@ TEST(ScenarioFiles, BadFieldsAreNamed) {
   expectFormatError(bad_posture, "start.configuration.posture", "half_sitting");
 }
 
+TEST(ScenarioFiles, APublishedRunIsReadWithItsFiguresAndBadOnesAreNamed) {
+  // chair_paper carries the paper's own run, which bench_scenarios prints
+  // beside the planner's (ISER 2008, section 3.2).
+  const Scenario paper = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
+  ASSERT_TRUE(paper.published.has_value());
+  EXPECT_NE(paper.published->source.find("ISER 2008"), std::string::npos);
+  EXPECT_EQ(paper.published->nodes, 2400);
+  EXPECT_EQ(paper.published->stances, 81);
+  EXPECT_DOUBLE_EQ(paper.published->seconds, 5 * 3600.0);
+  EXPECT_FALSE(Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml")).published.has_value());
+  // Only the source is required.
+  test::TempDir dir;
+  const Scenario bare = Scenario::load(dir.write("ok.yaml", scenarioText() + "published: {source: a talk}\n"));
+  ASSERT_TRUE(bare.published.has_value());
+  EXPECT_EQ(bare.published->nodes, 0);
+  EXPECT_EQ(bare.published->seconds, 0);
+  expectFormatError(scenarioText() + "published: {nodes: 10}\n", "published.source", "missing");
+  expectFormatError(scenarioText() + "published: {source: \"\"}\n", "published.source", "non-empty");
+  expectFormatError(scenarioText() + "published: {source: x, nodes: -5}\n", "published.nodes", "positive integer");
+  expectFormatError(scenarioText() + "published: {source: x, stances: 0}\n", "published.stances", "positive integer");
+  expectFormatError(scenarioText() + "published: {source: x, seconds: 0}\n", "published.seconds", "positive");
+  expectFormatError(scenarioText() + "published: {source: x, hours: 5}\n", "published.hours", "unknown field");
+  expectFormatError(scenarioText() + "published: [x]\n", "published", "source");
+}
+
 TEST(SceneFiles, BadFieldsNameTheSceneFile) {
   test::TempDir dir;
   auto load = [&](const std::string& body) {

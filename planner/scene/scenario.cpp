@@ -60,7 +60,7 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   YamlField root = YamlField::loadText(text, origin);
   root.requireFormat("acyclic.scenario/1");
   root.allowOnly({"format", "name", "robot", "scene", "seed", "start", "allowed_spots", "allowed_surfaces",
-                  "forbidden_contacts", "goal", "key_postures", "planner"});
+                  "forbidden_contacts", "goal", "key_postures", "planner", "published"});
   Scenario sc;
   sc.path = origin;
   sc.name = root.has("name") ? root["name"].string() : fs::path(origin).stem().string();
@@ -179,6 +179,27 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
   if (root.has("planner")) {
     if (!root["planner"].isMap()) root["planner"].fail("a map of planner parameters");
     sc.planner_section = root["planner"];
+  }
+  if (root.has("published")) {
+    const YamlField f = root["published"];
+    if (!f.isMap()) f.fail("a map: source, and any of nodes, stances, seconds, machine");
+    f.allowOnly({"source", "nodes", "stances", "seconds", "machine"});
+    PublishedRun ref;
+    ref.source = f["source"].string();
+    if (ref.source.empty()) f["source"].fail("a non-empty text naming the publication");
+    auto count = [&](const char* key, long& out) {
+      if (!f.has(key)) return;
+      out = f[key].integer();
+      if (out <= 0) f[key].fail("a positive integer");
+    };
+    count("nodes", ref.nodes);
+    count("stances", ref.stances);
+    if (f.has("seconds")) {
+      ref.seconds = f["seconds"].number();
+      if (!(ref.seconds > 0)) f["seconds"].fail("a positive number of seconds");
+    }
+    if (f.has("machine")) ref.machine = f["machine"].string();
+    sc.published = ref;
   }
   return sc;
 }

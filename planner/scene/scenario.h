@@ -41,6 +41,17 @@ struct GoalCondition {
   std::string describe(const RobotModel& m) const;
 };
 
+// Published figures for the problem a scenario reproduces (chair_paper: the
+// paper's own run), printed beside the planner's by bench_scenarios; 0 where
+// the source gives none.
+struct PublishedRun {
+  std::string source;   // who published it, where
+  long nodes = 0;       // nodes generated
+  long stances = 0;     // sets of contacts in the plan
+  double seconds = 0;   // planning time
+  std::string machine;  // what it ran on
+};
+
 struct Scenario {
   std::string path;
   std::string name;
@@ -60,6 +71,7 @@ struct Scenario {
   // The optional `planner:` section, read and validated by the planner
   // (planner/search/planner_parameters.h); absent: the planner's defaults.
   std::optional<YamlField> planner_section;
+  std::optional<PublishedRun> published;  // the optional `published:` section
 
   // Loads a scenario file; robot and scene paths resolve against its folder.
   static Scenario load(const std::string& path);
