@@ -244,6 +244,7 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
   double best = std::numeric_limits<double>::infinity();
   int best_piece = 0;
   double best_tau = 0;
+  int blends_searched = 0;
   for (int i = 0; i < static_cast<int>(pieces_.size()); ++i) {
     const Piece& p = pieces_[i];
     double tau;
@@ -252,6 +253,7 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
     } else {
       const double gap = (Pb - p.centre).norm() - p.radius * (1 + 1e-12) - 1e-12;
       if (gap > 0 && gap * gap > bound) continue;
+      ++blends_searched;
       tau = 0;
       double bd = std::numeric_limits<double>::infinity();
       for (int k = 0; k <= 16; ++k) {
@@ -272,6 +274,7 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
   const Piece& p = pieces_[best_piece];
   Projection pr;
   pr.piece = best_piece;
+  pr.blends_searched = blends_searched;
   const double sl = arcLength(p, best_tau);
   pr.s = p.s0 + sl;
   const Eigen::VectorXd c = basePoint(p, best_tau, 0), c1 = basePoint(p, best_tau, 1), c2 = basePoint(p, best_tau, 2);

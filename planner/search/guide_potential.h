@@ -43,6 +43,7 @@ class GuidePotential : public PostureCost {
     Eigen::VectorXd Q_s;          // dQ/ds
     Eigen::VectorXd grad_s;       // ds/dP (zero beyond the ends of T)
     int piece = 0;
+    int blends_searched = 0;      // blends not left out by their bounding ball
   };
   Projection project(const Eigen::VectorXd& P) const;
   double value(const Eigen::VectorXd& P) const;
