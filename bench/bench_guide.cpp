@@ -2,21 +2,21 @@
 // each scenario planned with the hand-written key postures and with the OMPL
 // guide only, side by side in one run: wall time, nodes, plan length, and the
 // independent check's verdict on each plan (planner/check/plan_check.h).
+// With --verify-transitions the plans are verified as acyclic-planner does;
+// --max-nodes and --max-posture-calls widen the scenarios' budgets (the
+// OMPL guide may need more than the hand-written one).
 // Usage: bench_guide [SCENARIO...] [OPTIONS]; --help lists the options.
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "cli_checks.h"
+#include "scenario_runs.h"
 
-#include "planner/check/plan_check.h"
 #include "planner/guide/guide_author.h"
 #include "planner/posture/heap_tuning.h"
-#include "planner/search/planner_parameters.h"
 
 using namespace acyclic;
 
@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::vector<std::string> paths;
   int seeds = 5;
-  double max_seconds = -1;  // not given: each scenario's budget
+  bench::PlannerOverrides overrides;
   CLI::App app{"The OMPL guide author: its time on each scenario (median over seeds), then each scenario planned\n"
                "with the hand-written key postures and with the OMPL guide only, side by side in one run: wall time,\n"
                "nodes, plan length, and the independent check's verdict on each plan."};
@@ -32,14 +32,11 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "the guide author is timed with seeds 1..N (median and max printed)")
       ->check(acyclic::bench::positive())
       ->capture_default_str();
-  app.add_option("--max-seconds", max_seconds, "time budget per planning run, s (default: the scenario's)")
-      ->check(acyclic::bench::positive());
+  overrides.addOptions(app, "planning run", true);
+  bool ompl_only = false;
+  app.add_flag("--ompl-only", ompl_only, "plan with the OMPL guide only, not also with the hand-written key postures");
   CLI11_PARSE(app, argc, argv);
-  if (paths.empty()) {  // every shipped scenario
-    for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
-      if (e.path().extension() == ".yaml") paths.push_back(e.path().string());
-    std::sort(paths.begin(), paths.end());
-  }
+  if (paths.empty()) paths = bench::shippedScenarios();
   std::printf("%-14s %-18s %12s %12s %8s\n", "scenario", "guide", "median s", "max s", "keys");
   std::vector<Guide> guides;
   for (const auto& path : paths) {
@@ -64,23 +61,19 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < paths.size(); ++i) {
     const Scenario base = Scenario::load(paths[i]);
     for (const bool ompl : {false, true}) {
+      if (ompl_only && !ompl) continue;
       Scenario sc = base;
       if (ompl) sc.key_postures = guides[i].key_postures;
       if (sc.key_postures.size() < 2) {
         std::printf("%-14s %-12s %-22s\n", sc.name.c_str(), ompl ? "OMPL" : "hand", "no key postures");
         continue;
       }
-      PlannerParameters p = plannerParameters(sc);
-      if (max_seconds > 0) p.max_seconds = max_seconds;
-      const PlanningResult r = ContactPlanner(sc, p).plan();
-      std::string verdict = "-";
-      if (r.solved()) {
-        ValidityChecker checker(sc.robot, sc.scene);
-        verdict = checkPlan(r.plan, sc, checker).valid() ? "valid" : "INVALID";
-      }
+      const PlanningResult r = ContactPlanner(sc, overrides.parameters(sc)).plan();
+      const std::string verdict = bench::planVerdict(r, sc);
       std::printf("%-14s %-12s %-22s %9.2f %7ld %9ld %8zu %s\n", sc.name.c_str(), ompl ? "OMPL" : "hand",
                   toString(r.status), r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls,
                   r.plan.stances.size(), verdict.c_str());
+      bench::printVerification(r);
       std::fflush(stdout);
     }
   }

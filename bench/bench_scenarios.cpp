@@ -5,39 +5,38 @@
 // is guided by the OMPL author first (planner/guide/guide_author.h); its
 // time is in the wall time.
 // Usage: bench_scenarios [SCENARIO...] [OPTIONS]   (default: every shipped scenario); --help lists the options.
-#include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "cli_checks.h"
+#include "scenario_runs.h"
 
-#ifdef ACYCLIC_HAVE_INTERPOLATOR
-#include "interpolator/plan_verifier.h"
-#endif
-#include "planner/check/plan_check.h"
 #include "planner/common/fmt.h"
 #include "planner/guide/guide_author.h"
 #include "planner/posture/heap_tuning.h"
-#include "planner/search/planner_parameters.h"
 
 using namespace acyclic;
 
 namespace {
 
 // The published run the scenario reproduces (its `published:` section), and
-// this run against it: nodes and stances as ratios, time as a factor.
-void printPublished(const Scenario& sc, const PlanningResult& r) {
+// this run against it (`seconds`: the row's, the guide's included): nodes
+// (the plan's search, and with a portfolio every member's) and stances as
+// ratios, time as a factor faster or slower.
+void printPublished(const Scenario& sc, const PlanningResult& r, double seconds) {
   const PublishedRun& ref = *sc.published;
   std::string figures, against;
   auto add = [](std::string& to, const std::string& what) { to += (to.empty() ? "" : ", ") + what; };
+  auto times = [](double x) { return fmt(x >= 10 ? "%.0f times" : "%.1f times", x); };
   if (ref.nodes > 0) {
     add(figures, fmt("%.0f nodes", static_cast<double>(ref.nodes)));
-    if (r.solved()) add(against, fmt("%.2f times its nodes", static_cast<double>(r.stats.nodes_generated) / ref.nodes));
+    if (r.solved())
+      add(against, fmt("%.2f times its nodes", static_cast<double>(r.stats.nodes_generated) / ref.nodes) +
+                       (r.members.empty() ? "" : fmt(" (%.2f with every member's)",
+                                                     static_cast<double>(r.portfolioNodes()) / ref.nodes)));
   }
   if (ref.stances > 0) {
     add(figures, fmt("%.0f stances", static_cast<double>(ref.stances)));
@@ -46,7 +45,9 @@ void printPublished(const Scenario& sc, const PlanningResult& r) {
   }
   if (ref.seconds > 0) {
     add(figures, fmt("%.0f s", ref.seconds) + (ref.machine.empty() ? "" : " on " + ref.machine));
-    if (r.solved() && r.stats.seconds > 0) add(against, fmt("%.0f times faster", ref.seconds / r.stats.seconds));
+    if (r.solved() && seconds > 0)
+      add(against, ref.seconds >= seconds ? times(ref.seconds / seconds) + " faster"
+                                          : times(seconds / ref.seconds) + " slower");
   }
   std::printf("%-14s   published: %s: %s%s\n", "", ref.source.c_str(), figures.empty() ? "no figures" : figures.c_str(),
               against.empty() ? "" : ("; this run " + against).c_str());
@@ -57,19 +58,12 @@ void printPublished(const Scenario& sc, const PlanningResult& r) {
 int main(int argc, char** argv) {
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   std::vector<std::string> paths;
-  double max_seconds = -1;  // not given: each scenario's budget
+  bench::PlannerOverrides overrides;
   CLI::App app{"Every scenario shipped in models/scenarios planned by the full planner, one after the other in one\n"
                "run: result, wall time, nodes, posture calls and failures, plan length, the non-foot contacts the\n"
                "plan uses, and the independent check's verdict on the plan."};
   app.add_option("scenario", paths, "scenario files (acyclic.scenario/1; default: every models/scenarios/*.yaml)");
-  app.add_option("--max-seconds", max_seconds, "time budget per scenario, s (default: the scenario's)")
-      ->check(acyclic::bench::positive());
-  bool verify = false;
-#ifdef ACYCLIC_HAVE_INTERPOLATOR
-  app.add_flag("--verify-transitions", verify,
-               "verify each plan's transitions with the interpolator's solver, as acyclic-planner does by default "
-               "(default here: the search alone, or the scenario's planner key verify_transitions)");
-#endif
+  overrides.addOptions(app, "scenario", true);
   GuideOptions guide_options;
   app.add_flag("--stable-guide", guide_options.stable,
                "scenarios without key postures: the OMPL guide through the statically stable subspace "
@@ -78,11 +72,7 @@ int main(int argc, char** argv) {
                "scenarios without key postures: the OMPL guide's key postures sampled along its edges as with "
                "--stable-guide, not projected (a control)");
   CLI11_PARSE(app, argc, argv);
-  if (paths.empty()) {
-    for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
-      if (e.path().extension() == ".yaml") paths.push_back(e.path().string());
-    std::sort(paths.begin(), paths.end());
-  }
+  if (paths.empty()) paths = bench::shippedScenarios();
   std::printf("%-14s %-16s %9s %7s %7s %7s %8s %-7s %s\n", "scenario", "result", "seconds", "nodes", "calls",
               "failed", "stances", "check", "non-foot contacts used");
   for (const auto& path : paths) {
@@ -105,17 +95,10 @@ int main(int argc, char** argv) {
       }
       sc.key_postures = g.guide.key_postures;
     }
-    PlannerParameters p = plannerParameters(sc);
-    if (max_seconds > 0) p.max_seconds = max_seconds;
-    if (verify) p.verify_transitions = true;
-#ifdef ACYCLIC_HAVE_INTERPOLATOR
-    attachPlanVerifier(p, sc);
-#endif
-    const PlanningResult r = ContactPlanner(sc, p).plan();
-    std::string verdict = "-", used;
+    const PlanningResult r = ContactPlanner(sc, overrides.parameters(sc)).plan();
+    const std::string verdict = bench::planVerdict(r, sc);
+    std::string used;
     if (r.solved()) {
-      ValidityChecker checker(sc.robot, sc.scene);
-      verdict = checkPlan(r.plan, sc, checker).valid() ? "valid" : "INVALID";
       std::set<std::string> names;
       for (const auto& st : r.plan.stances)
         for (const auto& c : st.contacts) {
@@ -139,11 +122,8 @@ int main(int argc, char** argv) {
       std::printf("%-14s   a portfolio of %zu searches: %ld nodes generated by all (%s)\n", "", r.members.size(),
                   r.portfolioNodes(), each.c_str());
     }
-    if (sc.published) printPublished(sc, r);
-    if (r.stats.plans_verified > 0)
-      std::printf("%-14s   transitions verified: %ld plans, %ld refused, %ld transitions solved, %.2f s of the %.2f s\n",
-                  "", r.stats.plans_verified, r.stats.plans_refused, r.stats.transitions_solved,
-                  r.stats.verify_seconds, r.stats.seconds);
+    if (sc.published) printPublished(sc, r, guide_seconds + r.stats.seconds);
+    bench::printVerification(r);
     std::fflush(stdout);
   }
   return 0;

@@ -1,0 +1,89 @@
+#pragma once
+// What bench_scenarios and bench_guide share when they plan shipped
+// scenarios: the default list of scenarios, the planner's budgets and
+// verification from the command line, the independent check's verdict on a
+// plan, and the verification's line under a row.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_checks.h"
+
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+#include "interpolator/plan_verifier.h"
+#endif
+#include "planner/check/plan_check.h"
+#include "planner/search/planner_parameters.h"
+
+namespace acyclic::bench {
+
+// Every scenario shipped in models/scenarios, in name order.
+inline std::vector<std::string> shippedScenarios() {
+  std::vector<std::string> paths;
+  for (const auto& e : std::filesystem::directory_iterator(ACYCLIC_SOURCE_DIR "/models/scenarios"))
+    if (e.path().extension() == ".yaml") paths.push_back(e.path().string());
+  std::sort(paths.begin(), paths.end());
+  return paths;
+}
+
+// The command line's changes to each scenario's planner parameters.
+struct PlannerOverrides {
+  double max_seconds = -1;  // not given (<= 0): the scenario's
+  long max_nodes = -1;
+  long max_posture_calls = -1;
+  bool verify = false;  // verify transitions (the planner's default in acyclic-planner)
+
+  // --max-seconds always; --max-nodes and --max-posture-calls with `budgets`.
+  void addOptions(CLI::App& app, const std::string& per, bool budgets) {
+    app.add_option("--max-seconds", max_seconds, "time budget per " + per + ", s (default: the scenario's)")
+        ->check(positive());
+    if (budgets) {
+      app.add_option("--max-nodes", max_nodes, "nodes generated at most per " + per + " (default: the scenario's)")
+          ->check(positive());
+      app.add_option("--max-posture-calls", max_posture_calls,
+                     "posture-generator calls at most per " + per + " (default: the scenario's)")
+          ->check(positive());
+    }
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+    app.add_flag("--verify-transitions", verify,
+                 "verify each plan's transitions with the interpolator's solver, as acyclic-planner does by default "
+                 "(default here: the search alone, or the scenario's planner key verify_transitions)");
+#endif
+  }
+
+  // The scenario's parameters with these changes, and a verifier when they
+  // verify transitions.
+  PlannerParameters parameters(const Scenario& sc) const {
+    PlannerParameters p = plannerParameters(sc);
+    if (max_seconds > 0) p.max_seconds = max_seconds;
+    if (max_nodes > 0) p.max_nodes = max_nodes;
+    if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
+    if (verify) p.verify_transitions = true;
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+    attachPlanVerifier(p, sc);
+#endif
+    return p;
+  }
+};
+
+// The independent check's verdict on a result's plan: valid, INVALID, or -
+// when there is no plan.
+inline std::string planVerdict(const PlanningResult& r, const Scenario& sc) {
+  if (!r.solved()) return "-";
+  ValidityChecker checker(sc.robot, sc.scene);
+  return checkPlan(r.plan, sc, checker).valid() ? "valid" : "INVALID";
+}
+
+// Under a row: what the verification of transitions did, if it ran.
+inline void printVerification(const PlanningResult& r) {
+  if (r.stats.plans_verified == 0) return;
+  std::printf("%-14s   transitions verified: %ld plans, %ld refused, %ld transitions solved, %.2f s of the %.2f s\n", "",
+              r.stats.plans_verified, r.stats.plans_refused, r.stats.transitions_solved, r.stats.verify_seconds,
+              r.stats.seconds);
+}
+
+}  // namespace acyclic::bench
