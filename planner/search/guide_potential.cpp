@@ -234,12 +234,18 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
   // answer, so a blend whose ball is farther than it cannot be the closest
   // piece and is not searched. The margin (1e-9, against ties decided at
   // 1e-15 below) keeps the choice exactly the one of searching every piece.
-  auto segmentTau = [&](const Piece& p) {
-    return p.len > 0 ? std::clamp((Pb - p.a).dot(p.u) / p.len, 0.0, 1.0) : 0.0;
+  // A segment's nearest point: its parameter and squared distance (an
+  // expression, no vector made: this runs in every cost evaluation).
+  auto nearestOnSegment = [&](const Piece& p, double& tau) {
+    tau = p.len > 0 ? std::clamp((Pb - p.a).dot(p.u) / p.len, 0.0, 1.0) : 0.0;
+    return (p.a + tau * p.len * p.u - Pb).squaredNorm();
   };
   double nearest_segment = std::numeric_limits<double>::infinity();
   for (const Piece& p : pieces_)
-    if (!p.blend) nearest_segment = std::min(nearest_segment, (basePoint(p, segmentTau(p), 0) - Pb).squaredNorm());
+    if (!p.blend) {
+      double tau;
+      nearest_segment = std::min(nearest_segment, nearestOnSegment(p, tau));
+    }
   const double bound = nearest_segment * (1 + 1e-9) + 1e-9;
   double best = std::numeric_limits<double>::infinity();
   int best_piece = 0;
@@ -247,9 +253,9 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
   int blends_searched = 0;
   for (int i = 0; i < static_cast<int>(pieces_.size()); ++i) {
     const Piece& p = pieces_[i];
-    double tau;
+    double tau, d;
     if (!p.blend) {
-      tau = segmentTau(p);
+      d = nearestOnSegment(p, tau);
     } else {
       const double gap = (Pb - p.centre).norm() - p.radius * (1 + 1e-12) - 1e-12;
       if (gap > 0 && gap * gap > bound) continue;
@@ -257,8 +263,8 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
       tau = 0;
       double bd = std::numeric_limits<double>::infinity();
       for (int k = 0; k <= 16; ++k) {
-        const double d = (blendPoint(p, k / 16.0, 0) - Pb).squaredNorm();
-        if (d < bd) bd = d, tau = k / 16.0;
+        const double dk = (blendPoint(p, k / 16.0, 0) - Pb).squaredNorm();
+        if (dk < bd) bd = dk, tau = k / 16.0;
       }
       for (int it = 0; it < 30; ++it) {  // Newton on (c - P) . c' = 0
         const Eigen::VectorXd c = blendPoint(p, tau, 0), c1 = blendPoint(p, tau, 1), c2 = blendPoint(p, tau, 2);
@@ -267,8 +273,8 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
         if (std::abs(next - tau) < 1e-15) break;
         tau = next;
       }
+      d = (blendPoint(p, tau, 0) - Pb).squaredNorm();
     }
-    const double d = (basePoint(p, tau, 0) - Pb).squaredNorm();
     if (d < best - 1e-15) best = d, best_piece = i, best_tau = tau;
   }
   const Piece& p = pieces_[best_piece];
