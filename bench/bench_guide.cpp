@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "the guide author is timed with seeds 1..N (median and max printed)")
       ->check(acyclic::bench::positive())
       ->capture_default_str();
-  overrides.addOptions(app, "planning run", true);
+  overrides.addOptions(app, "planning run");
   bool ompl_only = false;
   app.add_flag("--ompl-only", ompl_only, "plan with the OMPL guide only, not also with the hand-written key postures");
   CLI11_PARSE(app, argc, argv);

@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
                "run: result, wall time, nodes, posture calls and failures, plan length, the non-foot contacts the\n"
                "plan uses, and the independent check's verdict on the plan."};
   app.add_option("scenario", paths, "scenario files (acyclic.scenario/1; default: every models/scenarios/*.yaml)");
-  overrides.addOptions(app, "scenario", true);
+  overrides.addOptions(app, "scenario");
   GuideOptions guide_options;
   app.add_flag("--stable-guide", guide_options.stable,
                "scenarios without key postures: the OMPL guide through the statically stable subspace "

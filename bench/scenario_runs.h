@@ -37,17 +37,16 @@ struct PlannerOverrides {
   long max_posture_calls = -1;
   bool verify = false;  // verify transitions (the planner's default in acyclic-planner)
 
-  // --max-seconds always; --max-nodes and --max-posture-calls with `budgets`.
-  void addOptions(CLI::App& app, const std::string& per, bool budgets) {
+  // --max-seconds, --max-nodes, --max-posture-calls (each per `per`), and
+  // --verify-transitions where the interpolator is built.
+  void addOptions(CLI::App& app, const std::string& per) {
     app.add_option("--max-seconds", max_seconds, "time budget per " + per + ", s (default: the scenario's)")
         ->check(positive());
-    if (budgets) {
-      app.add_option("--max-nodes", max_nodes, "nodes generated at most per " + per + " (default: the scenario's)")
-          ->check(positive());
-      app.add_option("--max-posture-calls", max_posture_calls,
-                     "posture-generator calls at most per " + per + " (default: the scenario's)")
-          ->check(positive());
-    }
+    app.add_option("--max-nodes", max_nodes, "nodes generated at most per " + per + " (default: the scenario's)")
+        ->check(positive());
+    app.add_option("--max-posture-calls", max_posture_calls,
+                   "posture-generator calls at most per " + per + " (default: the scenario's)")
+        ->check(positive());
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
     app.add_flag("--verify-transitions", verify,
                  "verify each plan's transitions with the interpolator's solver, as acyclic-planner does by default "

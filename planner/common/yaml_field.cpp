@@ -130,6 +130,18 @@ int YamlField::integer() const {
   return v;
 }
 
+double YamlField::positiveNumber() const {
+  const double v = number();
+  if (!(v > 0)) fail("a positive number");
+  return v;
+}
+
+int YamlField::positiveInteger() const {
+  const int v = integer();
+  if (v < 1) fail("a positive integer");
+  return v;
+}
+
 bool YamlField::boolean() const {
   if (!node_.IsScalar()) fail("true or false");
   bool v;

@@ -47,6 +47,10 @@ class YamlField {
   double degrees() const;
   Eigen::Vector3d angles3(bool degrees) const;  // [a, b, c], in the unit asked for
   int integer() const;
+  // number() > 0 and integer() >= 1, else "a positive number" / "a positive
+  // integer", named with the file and field.
+  double positiveNumber() const;
+  int positiveInteger() const;
   bool boolean() const;
   std::string string() const;
   std::vector<std::string> strings() const;

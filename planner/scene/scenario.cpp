@@ -187,17 +187,9 @@ Scenario Scenario::loadText(const std::string& text, const std::string& origin, 
     PublishedRun ref;
     ref.source = f["source"].string();
     if (ref.source.empty()) f["source"].fail("a non-empty text naming the publication");
-    auto count = [&](const char* key, long& out) {
-      if (!f.has(key)) return;
-      out = f[key].integer();
-      if (out <= 0) f[key].fail("a positive integer");
-    };
-    count("nodes", ref.nodes);
-    count("stances", ref.stances);
-    if (f.has("seconds")) {
-      ref.seconds = f["seconds"].number();
-      if (!(ref.seconds > 0)) f["seconds"].fail("a positive number of seconds");
-    }
+    if (f.has("nodes")) ref.nodes = f["nodes"].positiveInteger();
+    if (f.has("stances")) ref.stances = f["stances"].positiveInteger();
+    if (f.has("seconds")) ref.seconds = f["seconds"].positiveNumber();
     if (f.has("machine")) ref.machine = f["machine"].string();
     sc.published = ref;
   }

@@ -21,16 +21,10 @@ const std::vector<std::string> kVariantKeys = {
 // Sets in p every key f has (f's keys already allowed by the caller).
 void readFields(const YamlField& f, PlannerParameters& p) {
   auto positive = [&](const char* key, double& out) {
-    if (!f.has(key)) return;
-    const double v = f[key].number();
-    if (!(v > 0)) f[key].fail("a positive number");
-    out = v;
+    if (f.has(key)) out = f[key].positiveNumber();
   };
   auto count = [&](const char* key, auto& out) {
-    if (!f.has(key)) return;
-    const int v = f[key].integer();
-    if (v < 1) f[key].fail("a positive integer");
-    out = v;
+    if (f.has(key)) out = f[key].positiveInteger();
   };
   positive("potential_k", p.potential_k);
   positive("smoothing_tolerance", p.smoothing_tolerance);
