@@ -16,6 +16,7 @@
 
 #include "planner/common/fmt.h"
 #include "planner/guide/guide_author.h"
+#include "planner/plan/guide.h"
 #include "planner/posture/heap_tuning.h"
 
 using namespace acyclic;
@@ -71,12 +72,18 @@ int main(int argc, char** argv) {
   app.add_flag("--edge-samples-guide", guide_options.sample_edges,
                "scenarios without key postures: the OMPL guide's key postures sampled along its edges as with "
                "--stable-guide, not projected (a control)");
+  std::string guide_file;
+  app.add_option("--guide", guide_file,
+                 "key postures from this guide file (acyclic.guide/1) instead of the scenario's, as acyclic-planner "
+                 "--guide (e.g. models/guides/chair_paper_hand_on_chair.guide.json for chair_paper)")
+      ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   if (paths.empty()) paths = bench::shippedScenarios();
   std::printf("%-14s %-16s %9s %7s %7s %7s %8s %-7s %s\n", "scenario", "result", "seconds", "nodes", "calls",
               "failed", "stances", "check", "non-foot contacts used");
   for (const auto& path : paths) {
     Scenario sc = Scenario::load(path);
+    if (!guide_file.empty()) sc.key_postures = readGuide(guide_file, sc).key_postures;
     double guide_seconds = 0;
     const bool guided = sc.key_postures.size() < 2;
     std::string guide_kind;
@@ -110,6 +117,8 @@ int main(int argc, char** argv) {
     std::printf("%-14s %-16s %9.2f %7ld %7ld %7ld %8zu %-7s %s\n", sc.name.c_str(), toString(r.status),
                 guide_seconds + r.stats.seconds, r.stats.nodes_generated, r.stats.posture_calls, r.stats.posture_failures,
                 r.plan.stances.size(), verdict.c_str(), used.empty() ? "none" : used.c_str());
+    if (!guide_file.empty())
+      std::printf("%-14s   guided by %s: %zu key postures\n", "", guide_file.c_str(), sc.key_postures.size());
     if (guided)
       std::printf("%-14s   guided by the OMPL author: %zu key postures in %.2f s%s\n", "", sc.key_postures.size(),
                   guide_seconds, guide_kind.c_str());

@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
       "With --stable, paths through the statically stable subspace: every key posture in static\n"
       "equilibrium on the contacts it makes (section 7 of docs/design.md).\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
+      "With --scenario-keys, writes the scenario's own (hand-written) key postures instead, as parsed: a\n"
+      "guide to edit and plan with beside the scenario's (models/scenarios/chair_paper_hand_on_chair.guide.json).\n"
       "File mode: --in SCENARIO --out GUIDE; exit status 0 written, 1 no guide (reason printed), 2 bad input.\n"
       "LCM mode: --lcm answers every ACYCLIC_REQUEST whose scenario has no key postures with ACYCLIC_GUIDE\n"
       "(same request id; the planner waits for it); ACYCLIC_STATUS at 1 Hz and on errors; ACYCLIC_CANCEL.\n"
@@ -61,6 +63,12 @@ int main(int argc, char** argv) {
   app.add_option("--stable-step", o.stable_step, "m of base travel between samples with --stable")->capture_default_str();
   app.add_option("--stable-reach", o.stable_reach, "m: a spot this close to a surface rests on it, with --stable")
       ->capture_default_str();
+  bool scenario_keys = false;
+  app.add_flag("--scenario-keys", scenario_keys,
+               "write the scenario's own key postures (bit for bit as parsed) instead of authoring a guide");
+  std::string source;
+  app.add_option("--source", source, "the guide's source text (default \"hand\"): where its key postures come from")
+      ->needs("--scenario-keys");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.crouch = !no_crouch;
   o.crawl = !no_crawl;
@@ -73,6 +81,17 @@ int main(int argc, char** argv) {
   }
   try {
     const Scenario sc = Scenario::load(in);
+    if (scenario_keys) {
+      if (sc.key_postures.size() < 2) {
+        std::fprintf(stderr, "acyclic-guide: %s: key_postures: the scenario has fewer than two key postures to write\n",
+                     in.c_str());
+        return 2;
+      }
+      writeGuide(Guide{in, source.empty() ? "hand" : source, sc.key_postures, 0.0}, sc, out);
+      std::printf("acyclic-guide: %s: its %zu key postures written to %s\n", sc.name.c_str(), sc.key_postures.size(),
+                  out.c_str());
+      return 0;
+    }
     o.seed = static_cast<unsigned>(seed >= 0 ? seed : static_cast<long>(sc.seed));
     const GuideResult r = authorGuide(sc, o, &proc::stopFlag());
     if (!r.success()) {
