@@ -82,8 +82,14 @@ int main(int argc, char** argv) {
   std::printf("%-14s %-16s %9s %7s %7s %7s %8s %-7s %s\n", "scenario", "result", "seconds", "nodes", "calls",
               "failed", "stances", "check", "non-foot contacts used");
   for (const auto& path : paths) {
-    Scenario sc = Scenario::load(path);
-    if (!guide_file.empty()) sc.key_postures = readGuide(guide_file, sc).key_postures;
+    Scenario sc;
+    try {  // a bad file is said with its name and field, not an abort
+      sc = Scenario::load(path);
+      if (!guide_file.empty()) sc.key_postures = readGuide(guide_file, sc).key_postures;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_scenarios: %s\n", e.what());
+      return 2;
+    }
     double guide_seconds = 0;
     const bool guided = sc.key_postures.size() < 2;
     std::string guide_kind;

@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
       "equilibrium on the contacts it makes (section 7 of docs/design.md).\n"
       "Writes acyclic.guide/1 (give it to acyclic-planner --guide). Same scenario and seed, same guide.\n"
       "With --scenario-keys, writes the scenario's own (hand-written) key postures instead, as parsed: a\n"
-      "guide to edit and plan with beside the scenario's (models/scenarios/chair_paper_hand_on_chair.guide.json).\n"
+      "guide to edit and plan with beside the scenario's (models/guides/chair_paper_hand_on_chair.guide.json).\n"
       "File mode: --in SCENARIO --out GUIDE; exit status 0 written, 1 no guide (reason printed), 2 bad input.\n"
       "LCM mode: --lcm answers every ACYCLIC_REQUEST whose scenario has no key postures with ACYCLIC_GUIDE\n"
       "(same request id; the planner waits for it); ACYCLIC_STATUS at 1 Hz and on errors; ACYCLIC_CANCEL.\n"
