@@ -5,6 +5,9 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "planner/common/geometry.h"
 
@@ -240,11 +243,18 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
     tau = p.len > 0 ? std::clamp((Pb - p.a).dot(p.u) / p.len, 0.0, 1.0) : 0.0;
     return (p.a + tau * p.len * p.u - Pb).squaredNorm();
   };
+  // Each segment's (tau, d) is kept from this first pass for the second,
+  // which decides ties in piece order. The buffer is per thread and reused,
+  // so no allocation happens per call once it has grown.
+  thread_local std::vector<std::pair<double, double>> segment_nearest;
+  segment_nearest.resize(pieces_.size());
   double nearest_segment = std::numeric_limits<double>::infinity();
-  for (const Piece& p : pieces_)
-    if (!p.blend) {
+  for (size_t i = 0; i < pieces_.size(); ++i)
+    if (!pieces_[i].blend) {
       double tau;
-      nearest_segment = std::min(nearest_segment, nearestOnSegment(p, tau));
+      const double d = nearestOnSegment(pieces_[i], tau);
+      segment_nearest[i] = {tau, d};
+      nearest_segment = std::min(nearest_segment, d);
     }
   const double bound = nearest_segment * (1 + 1e-9) + 1e-9;
   double best = std::numeric_limits<double>::infinity();
@@ -255,7 +265,7 @@ GuidePotential::Projection GuidePotential::project(const Eigen::VectorXd& P) con
     const Piece& p = pieces_[i];
     double tau, d;
     if (!p.blend) {
-      d = nearestOnSegment(p, tau);
+      std::tie(tau, d) = segment_nearest[i];
     } else {
       const double gap = (Pb - p.centre).norm() - p.radius * (1 + 1e-12) - 1e-12;
       if (gap > 0 && gap * gap > bound) continue;
