@@ -66,8 +66,11 @@ int main(int argc, char** argv) {
   bool scenario_keys = false;
   app.add_flag("--scenario-keys", scenario_keys,
                "write the scenario's own key postures (bit for bit as parsed) instead of authoring a guide");
-  std::string source;
-  app.add_option("--source", source, "the guide's source text (default \"hand\"): where its key postures come from")
+  std::string source = "hand";
+  app.add_option("--source", source, "the guide's source text: where its key postures come from")
+      ->capture_default_str()
+      ->check(CLI::Validator([](std::string& s) { return s.empty() ? std::string("give a non-empty text") : ""; },
+                             "TEXT"))
       ->needs("--scenario-keys");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.crouch = !no_crouch;
@@ -87,7 +90,7 @@ int main(int argc, char** argv) {
                      in.c_str());
         return 2;
       }
-      writeGuide(Guide{in, source.empty() ? "hand" : source, sc.key_postures, 0.0}, sc, out);
+      writeGuide(Guide{in, source, sc.key_postures, 0.0}, sc, out);
       std::printf("acyclic-guide: %s: its %zu key postures written to %s\n", sc.name.c_str(), sc.key_postures.size(),
                   out.c_str());
       return 0;

@@ -36,6 +36,16 @@ TEST(AcyclicGuide, ScenarioKeysAreWrittenBitForBitWithTheirSource) {
   ASSERT_EQ(g.key_postures.size(), sc.key_postures.size());
   for (std::size_t i = 0; i < g.key_postures.size(); ++i)
     expectSameBits(g.key_postures[i], sc.key_postures[i], "key posture " + std::to_string(i + 1));
+  // Without --source the text is "hand"; an empty one is refused.
+  const auto d = test::runProcess(test::binaryPath("processes/acyclic-guide") + " --in " +
+                                  test::sourcePath(kChairPaper) + " --scenario-keys --out " + dir.path() + "/d.json");
+  ASSERT_EQ(d.status, 0) << d.output;
+  EXPECT_EQ(readGuide(dir.path() + "/d.json", sc).source, "hand");
+  const auto e = test::runProcess(test::binaryPath("processes/acyclic-guide") + " --in " +
+                                  test::sourcePath(kChairPaper) + " --scenario-keys --source '' --out " + dir.path() +
+                                  "/e.json");
+  EXPECT_NE(e.status, 0) << e.output;
+  EXPECT_NE(e.output.find("non-empty"), std::string::npos) << e.output;
 }
 
 TEST(AcyclicGuide, ScenarioKeysOfAScenarioWithoutThemIsBadInputNamingTheField) {
