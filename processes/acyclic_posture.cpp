@@ -4,10 +4,13 @@
 // whole surface, touching, geometric only. Prints the result, the witness's
 // centre of mass and the independent check; writes the witness as a one-stance
 // plan when asked. For scenario authors: is this stance feasible at all?
+// With --from PLAN --stance K, a plan's stance as the plan holds it: does it
+// still exist with stability margins?
 // Exit: 0 found and valid, 1 not found or not valid, 2 bad input.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <string>
 
 #include "processes/command_line.h"
 #include "planner/check/validity.h"
@@ -21,8 +24,8 @@ using namespace acyclic;
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "One posture-generator call on a scenario's start stance (or a plan's last stance, --from), as the\n"
-      "planner makes one son:\n"
+      "One posture-generator call on a scenario's start stance (or a plan's last stance, --from, or any\n"
+      "of its stances as the plan holds it, --stance), as the planner makes one son:\n"
       "  --remove SPOT: that start contact stays touching but stops supporting (repeatable);\n"
       "  --add SPOT@SURFACE: a contact floating over the whole surface, touching, not supporting.\n"
       "Cost: distance to the start configuration. Prints the status, the witness's centre of mass and\n"
@@ -37,6 +40,11 @@ int main(int argc, char** argv) {
   app.add_option("--from", from,
                  "start from the last stance of this plan instead (its contacts all supporting, as the planner's "
                  "node after the change settles)");
+  int stance_index = -1;
+  app.add_option("--stance", stance_index,
+                 "with --from: re-pose this stance of the plan (0 the start) as the plan holds it, its touching but "
+                 "not supporting contacts as they are (the call that made it, e.g. to probe it with margins)")
+      ->needs("--from");
   app.add_option("--remove", remove, "a start contact's spot that stops supporting (repeatable)");
   app.add_option("--add", add, "SPOT@SURFACE: a contact to add, floating over the surface");
   app.add_option("--iterations", iterations, "Ipopt iterations at most")->capture_default_str();
@@ -79,9 +87,17 @@ int main(int argc, char** argv) {
     if (!from.empty()) {
       const Plan p = readPlan(from, sc);
       if (p.stances.empty()) throw FormatError(from, "stances", "at least one stance");
-      r.contacts = p.stances.back().specs();
-      for (auto& c : r.contacts) c.supporting = true;
-      r.initial_guess = p.stances.back().configuration;
+      const int n = static_cast<int>(p.stances.size());
+      if (stance_index >= n || stance_index < -1)
+        throw FormatError("--stance", std::to_string(stance_index),
+                          "a stance of " + from + ", 0 to " + std::to_string(n - 1));
+      const PlanStance& st = p.stances[static_cast<std::size_t>(stance_index < 0 ? n - 1 : stance_index)];
+      r.contacts = st.specs();
+      // The last stance as the planner's node once its change settles (all
+      // supporting); a stance named by --stance exactly as the plan holds it.
+      if (stance_index < 0)
+        for (auto& c : r.contacts) c.supporting = true;
+      r.initial_guess = st.configuration;
     }
     for (const auto& name : remove) {
       bool found = false;

@@ -5,6 +5,8 @@
 
 #include <fstream>
 
+#include "planner/plan/plan.h"
+#include "planner/scene/scenario.h"
 #include "test_support.h"
 
 namespace {
@@ -84,6 +86,58 @@ TEST(AcyclicPosture, ThePapersChairReleasesOneThighOnTheFeetButNotBoth) {
   EXPECT_EQ(one.status, 0) << one.output;
   const auto both = acyclic::test::runProcess(bin + " --remove r_thigh --remove l_thigh --iterations 1000");
   EXPECT_EQ(both.status, 1) << both.output;
+}
+
+namespace {
+// The status line's outcome and iterations (its milliseconds vary) and the witness line.
+std::string outcome(const std::string& output) {
+  const auto ms = output.find(" iterations");
+  const auto witness = output.find("  witness:");
+  if (ms == std::string::npos || witness == std::string::npos) return "no outcome in: " + output;
+  return output.substr(0, ms) + output.substr(witness, output.find('\n', witness) - witness);
+}
+}  // namespace
+
+TEST(AcyclicPosture, StanceReposesAPlansStanceAsThePlanHoldsIt) {
+  // A two-stance plan: the start re-posed (all supporting), then the same
+  // posture with the right thigh touching but not supporting. --stance 1
+  // must be the very call `--from` the first with `--remove r_thigh` makes,
+  // and --stance 0 the call on the first stance as it is.
+  acyclic::test::TempDir dir;
+  const auto a = probe("--out " + dir.path() + "/a.json");
+  ASSERT_EQ(a.status, 0) << a.output;
+  const acyclic::Scenario sc = acyclic::Scenario::load(acyclic::test::sourcePath("models/scenarios/chair_table.yaml"));
+  acyclic::Plan p = acyclic::readPlan(dir.path() + "/a.json", sc);
+  acyclic::PlanStance released = p.stances.front();
+  int flagged = 0;
+  for (auto& c : released.contacts)
+    if (sc.robot->spots()[c.spec.spot].name == "r_thigh") c.spec.supporting = false, ++flagged;
+  ASSERT_EQ(flagged, 1);
+  p.stances.push_back(released);
+  acyclic::writePlan(p, sc, dir.path() + "/two.json");
+
+  const auto removed = probe("--from " + dir.path() + "/a.json --remove r_thigh");
+  const auto second = probe("--from " + dir.path() + "/two.json --stance 1");
+  ASSERT_EQ(removed.status, 0) << removed.output;
+  EXPECT_EQ(second.status, 0) << second.output;
+  EXPECT_EQ(outcome(second.output), outcome(removed.output));
+  const auto first = probe("--from " + dir.path() + "/two.json --stance 0");
+  const auto same = probe("--from " + dir.path() + "/a.json");
+  EXPECT_EQ(first.status, 0) << first.output;
+  EXPECT_EQ(outcome(first.output), outcome(same.output));
+  // Without --stance, the last stance with every contact supporting (the
+  // planner's node once the change settles): the released thigh supports again.
+  const auto last = probe("--from " + dir.path() + "/two.json");
+  EXPECT_EQ(outcome(last.output), outcome(same.output));
+  EXPECT_NE(outcome(last.output), outcome(removed.output));
+
+  auto bad = probe("--from " + dir.path() + "/two.json --stance 2");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.output.find("--stance"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("0 to 1"), std::string::npos) << bad.output;
+  bad = probe("--stance 0");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.output.find("--from"), std::string::npos) << bad.output;
 }
 
 TEST(AcyclicPosture, BadInputIsNamedAndExitsTwo) {
