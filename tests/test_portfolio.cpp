@@ -207,6 +207,31 @@ TEST(Portfolio, AMemberThatFailsDoesNotFailThePortfolio) {
   EXPECT_TRUE(none.plan.stances.empty());
 }
 
+// Every member's refused plans reach the caller, named by member, with the
+// plans themselves when asked (--keep-refused): here no member solves, and
+// before, the result carried none of them.
+TEST(Portfolio, EveryMembersRefusalsAreKeptNamedByMember) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  p.keep_refused_plans = true;
+  p.portfolio = {{"refusing", refuseEveryPlan}, {"also refusing", refuseEveryPlan}};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_FALSE(r.solved());
+  ASSERT_EQ(r.members.size(), 2u);
+  long refused = 0;
+  for (const auto& m : r.members) {
+    EXPECT_GT(m.stats.plans_refused, 0) << m.name;
+    refused += m.stats.plans_refused;
+  }
+  EXPECT_EQ(static_cast<long>(r.refusals.size()), refused);
+  ASSERT_EQ(r.refusal_members.size(), r.refusals.size());
+  EXPECT_EQ(r.refused_plans.size(), r.refusals.size());
+  // In the members' order, each line as its member wrote it.
+  EXPECT_EQ(r.refusal_members.front(), "refusing");
+  EXPECT_EQ(r.refusal_members.back(), "also refusing");
+  for (const std::string& why : r.refusals) EXPECT_EQ(why.rfind("stances 0 -> 1: refused by the test", 0), 0u) << why;
+}
+
 TEST(Portfolio, ACancelReachesEveryMember) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_table.yaml"));
   PlannerParameters p = plannerParameters(sc);

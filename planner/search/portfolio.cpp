@@ -188,6 +188,19 @@ PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, 
       out.reason += (i ? "; " : "") + names[i] + ": " + results[i].reason;
     out.stats = combined(latest);
   }
+  // Every member's refused plans, the winner's first, each with its
+  // member's name: a refusal is worth reading whichever member met it (a
+  // refused plan of a member that lost, or of members none of which solved,
+  // was lost before, --keep-refused included).
+  out.refusal_members.assign(out.refusals.size(), winner >= 0 ? names[winner] : std::string());
+  for (std::size_t i = 0; i < n; ++i) {
+    if (static_cast<int>(i) == winner) continue;
+    for (const std::string& s : results[i].refusals) {
+      out.refusals.push_back(s);
+      out.refusal_members.push_back(names[i]);
+    }
+    for (RefusedPlan& rp : results[i].refused_plans) out.refused_plans.push_back(std::move(rp));
+  }
   out.members = std::move(outcomes);
   out.winner = winner;
   // The wall time the caller waited: every member stopped.
