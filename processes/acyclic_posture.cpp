@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "processes/command_line.h"
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
   app.add_option("--stance", stance_index,
                  "with --from: re-pose this stance of the plan (0 the start) as the plan holds it, its touching but "
                  "not supporting contacts as they are (the call that made it, e.g. to probe it with margins)")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
       ->needs("--from");
   app.add_option("--remove", remove, "a start contact's spot that stops supporting (repeatable)");
   app.add_option("--add", add, "SPOT@SURFACE: a contact to add, floating over the surface");
@@ -88,7 +90,7 @@ int main(int argc, char** argv) {
       const Plan p = readPlan(from, sc);
       if (p.stances.empty()) throw FormatError(from, "stances", "at least one stance");
       const int n = static_cast<int>(p.stances.size());
-      if (stance_index >= n || stance_index < -1)
+      if (stance_index >= n)
         throw FormatError("--stance", std::to_string(stance_index),
                           "a stance of " + from + ", 0 to " + std::to_string(n - 1));
       const PlanStance& st = p.stances[static_cast<std::size_t>(stance_index < 0 ? n - 1 : stance_index)];
