@@ -38,6 +38,15 @@ void BM_SetConfiguration(benchmark::State& st) {
 }
 BENCHMARK(BM_SetConfiguration)->Unit(benchmark::kMicrosecond);
 
+// Link poses only, composed without Simbody (the limb planner's clearance checks).
+void BM_SetPoses(benchmark::State& st) {
+  Kinematics k(model());
+  const auto qs = configurations();
+  std::size_t i = 0;
+  for (auto _ : st) k.setPoses(qs[i++ % qs.size()]);
+}
+BENCHMARK(BM_SetPoses)->Unit(benchmark::kMicrosecond);
+
 void BM_AllSpotFrameJacobians(benchmark::State& st) {
   // Position + every contact spot's 6 x 36 frame Jacobian (12 spots).
   Kinematics k(model());

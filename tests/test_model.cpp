@@ -251,6 +251,38 @@ TEST(Hrp2Model, ChainJacobiansMatchSimbody) {
   }
 }
 
+// Poses composed along the tree from the joints' origins (setPoses, the
+// limb planner's clearance checks) are Simbody's to rounding; Simbody's
+// queries refuse a state setPoses left behind, until setConfiguration.
+TEST(Hrp2Model, PosesWithoutSimbodyAgreeWithSimbodyAndStaleQueriesThrow) {
+  const auto m = hrp2();
+  std::mt19937 rng(11);
+  Kinematics simbody(m), poses(m);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Configuration q = randomConfiguration(*m, rng);
+    simbody.setConfiguration(q);
+    poses.setPoses(q);
+    for (const auto& l : m->links()) {
+      EXPECT_LT((poses.linkPose(l.index).matrix() - simbody.linkPose(l.index).matrix()).cwiseAbs().maxCoeff(), 1e-12)
+          << l.name;
+    }
+    for (const auto& j : m->joints()) {
+      EXPECT_LT((poses.jointAxis(j.index) - simbody.jointAxis(j.index)).norm(), 1e-12) << j.name;
+      EXPECT_LT((poses.jointOrigin(j.index) - simbody.jointOrigin(j.index)).norm(), 1e-12) << j.name;
+    }
+    const int spot = m->spotIndex("r_sole");
+    EXPECT_LT((poses.spotPose(spot).matrix() - simbody.spotPose(spot).matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  }
+  EXPECT_THROW(poses.pointJacobian(0, Eigen::Vector3d::Zero()), std::logic_error);
+  EXPECT_THROW(poses.frameJacobian(0, Eigen::Vector3d::Zero()), std::logic_error);
+  EXPECT_THROW(poses.centerOfMass(), std::logic_error);
+  EXPECT_THROW(poses.centerOfMassJacobian(), std::logic_error);
+  EXPECT_THROW(poses.gravityTorques(), std::logic_error);
+  poses.setConfiguration(simbody.configuration());
+  EXPECT_LT((poses.centerOfMass() - simbody.centerOfMass()).norm(), 1e-15);
+  EXPECT_THROW(poses.setPoses(Configuration{}), std::invalid_argument);
+}
+
 // Acceleration limits: the robot file's default and per-joint overrides;
 // a bad value or an unknown joint is named with the file and the field.
 TEST(Hrp2Model, AccelerationLimitsFromTheRobotFile) {

@@ -193,7 +193,7 @@ double CollisionModel::lowerBound(const Kinematics& kin, int i) const {
 std::vector<int> CollisionModel::pairsWithin(const Kinematics& kin, double cutoff) const {
   std::vector<int> out;
   for (int i = 0; i < static_cast<int>(pairs_.size()); ++i)
-    if (lowerBound(kin, i) <= cutoff) out.push_back(i);
+    if (mayBeWithin(kin, i, cutoff)) out.push_back(i);
   return out;
 }
 

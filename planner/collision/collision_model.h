@@ -71,6 +71,9 @@ class CollisionModel {
   PairDistance pairDistance(const Kinematics& kin, int pair, bool gradient) const;
   // The pairs that bounding volumes cannot rule out within `cutoff`.
   std::vector<int> pairsWithin(const Kinematics& kin, double cutoff) const;
+  // Whether bounding volumes cannot rule pair `pair` out within `cutoff`
+  // (pairsWithin's test for one pair).
+  bool mayBeWithin(const Kinematics& kin, int pair, double cutoff) const { return lowerBound(kin, pair) <= cutoff; }
 
  private:
   struct Geometry;

@@ -24,11 +24,15 @@ Kinematics::Kinematics(std::shared_ptr<const RobotModel> model)
 
 Kinematics::~Kinematics() = default;
 
-void Kinematics::setConfiguration(const Configuration& q) {
-  const auto& S = model_->impl();
+void Kinematics::requireSize(const Configuration& q) const {
   if (q.joints.size() != model_->numJoints())
     throw std::invalid_argument("Kinematics: configuration has " + std::to_string(q.joints.size()) +
                                 " joints, the model " + std::to_string(model_->numJoints()));
+}
+
+void Kinematics::setConfiguration(const Configuration& q) {
+  const auto& S = model_->impl();
+  requireSize(q);
   q_ = q;
   const Eigen::Quaterniond o = q.base_orientation.normalized();
   SimTK::Transform X(SimTK::Rotation(SimTK::Quaternion(o.w(), o.x(), o.y(), o.z())), toVec3(q.base_position));
@@ -47,6 +51,23 @@ void Kinematics::setConfiguration(const Configuration& q) {
       for (int k = 0; k < 3; ++k) T.linear()(i, k) = R(i, k);
     T.translation() = toEigen(X.p());
   }
+  simbody_current_ = true;
+  setJointFrames();
+}
+
+void Kinematics::setPoses(const Configuration& q) {
+  requireSize(q);
+  q_ = q;
+  simbody_current_ = false;
+  link_pose_.resize(model_->numLinks());
+  link_pose_[0] = q.basePose();
+  // Joints come parent first (RobotModel refuses another order).
+  for (const auto& j : model_->joints())
+    link_pose_[j.child_link] = link_pose_[j.parent_link] * j.origin * Eigen::AngleAxisd(q.joints[j.index], j.axis);
+  setJointFrames();
+}
+
+void Kinematics::setJointFrames() {
   // A joint's frame is its child link's frame: its axis there is unchanged by its own rotation.
   joint_axis_.resize(model_->numJoints());
   joint_origin_.resize(model_->numJoints());
@@ -80,12 +101,18 @@ void Kinematics::addAxisGradient(int link, const Eigen::Vector3d& u, const Eigen
   for (int j : model_->ancestorJoints(link)) grad[6 + j] += joint_axis_[j].dot(uxw);
 }
 
+void Kinematics::requireSimbody(const char* query) const {
+  if (!simbody_current_)
+    throw std::logic_error(std::string("Kinematics::") + query + " after setPoses: call setConfiguration first");
+}
+
 Eigen::Isometry3d Kinematics::spotPose(int spot) const {
   const ContactSpot& s = model_->spots().at(spot);
   return linkPose(s.link) * s.frame;
 }
 
 Eigen::MatrixXd Kinematics::pointJacobian(int link, const Eigen::Vector3d& p) const {
+  requireSimbody("pointJacobian");
   const auto& S = model_->impl();
   S.matter.calcStationJacobian(state_->s, S.link_mobod.at(link), toVec3(p), state_->scratch);
   const SimTK::Matrix& J = state_->scratch;
@@ -98,6 +125,7 @@ Eigen::MatrixXd Kinematics::pointJacobian(int link, const Eigen::Vector3d& p) co
 }
 
 Eigen::MatrixXd Kinematics::frameJacobian(int link, const Eigen::Vector3d& origin) const {
+  requireSimbody("frameJacobian");
   const auto& S = model_->impl();
   S.matter.calcFrameJacobian(state_->s, S.link_mobod.at(link), toVec3(origin), state_->scratch);
   const SimTK::Matrix& J = state_->scratch;  // rows: angular(3), linear(3)
@@ -113,11 +141,13 @@ Eigen::MatrixXd Kinematics::frameJacobian(int link, const Eigen::Vector3d& origi
 }
 
 Eigen::Vector3d Kinematics::centerOfMass() const {
+  requireSimbody("centerOfMass");
   const auto& S = model_->impl();
   return toEigen(S.matter.calcSystemMassCenterLocationInGround(state_->s));
 }
 
 Eigen::MatrixXd Kinematics::centerOfMassJacobian() const {
+  requireSimbody("centerOfMassJacobian");
   // Simbody has no system mass-centre Jacobian: row k is J^T applied to the
   // forces (m_i / M) e_k at each link's centre of mass, one O(n) pass per row.
   const auto& S = model_->impl();
@@ -142,6 +172,7 @@ Eigen::MatrixXd Kinematics::centerOfMassJacobian() const {
 }
 
 Eigen::VectorXd Kinematics::gravityTorques() const {
+  requireSimbody("gravityTorques");
   const auto& S = model_->impl();
   const int nb = S.matter.getNumBodies();
   SimTK::Vector_<SimTK::SpatialVec> F(nb, SimTK::SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));

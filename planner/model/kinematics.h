@@ -26,9 +26,17 @@ class Kinematics {
   const std::shared_ptr<const RobotModel>& modelPtr() const { return model_; }
 
   void setConfiguration(const Configuration& q);
+  // Only what collision queries read (link poses, joint axes and origins),
+  // composed along the tree from the joints' origins without Simbody: a
+  // tenth of setConfiguration's time, for clearance checks in bulk (the
+  // limb path planner's). The poses agree with setConfiguration's to
+  // rounding, not bit for bit, so nothing whose result feeds a search is
+  // built on it. Until the next setConfiguration, the Simbody queries
+  // (Jacobians, centre of mass, gravity torques) throw std::logic_error.
+  void setPoses(const Configuration& q);
   const Configuration& configuration() const { return q_; }
 
-  // Cached at setConfiguration (no Simbody call).
+  // Cached at setConfiguration and setPoses (no Simbody call).
   const Eigen::Isometry3d& linkPose(int link) const { return link_pose_[link]; }
   const Eigen::Vector3d& jointAxis(int joint) const { return joint_axis_[joint]; }      // world
   const Eigen::Vector3d& jointOrigin(int joint) const { return joint_origin_[joint]; }  // world
@@ -57,9 +65,13 @@ class Kinematics {
 
  private:
   struct State;
+  void requireSize(const Configuration& q) const;  // std::invalid_argument on another joint count
+  void setJointFrames();
+  void requireSimbody(const char* query) const;  // throws after setPoses
   std::shared_ptr<const RobotModel> model_;
   std::unique_ptr<State> state_;
   Configuration q_;
+  bool simbody_current_ = false;  // the Simbody state is at q_
   std::vector<Eigen::Isometry3d> link_pose_;
   std::vector<Eigen::Vector3d> joint_axis_, joint_origin_;
 };

@@ -134,6 +134,7 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
     if (j.effort <= 0 || j.velocity <= 0)
       throw FormatError(ufile, "joint " + jn + " limit", "positive effort and velocity");
     j.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z).normalized();
+    j.origin = toEigen(uj->parent_to_joint_origin_transform);
     addLink(uj->child_link_name, j.index);
     j.child_link = static_cast<int>(m->links_.size()) - 1;
     m->joints_.push_back(j);
@@ -199,8 +200,7 @@ std::shared_ptr<const RobotModel> RobotModel::load(const std::string& yaml_path)
   S.base_mobod = baseBody.getMobilizedBodyIndex();
   S.link_mobod[0] = S.base_mobod;
   for (const auto& j : m->joints_) {
-    auto uj = urdf->getJoint(j.name);
-    Eigen::Isometry3d X_PJ = toEigen(uj->parent_to_joint_origin_transform);
+    const Eigen::Isometry3d& X_PJ = j.origin;
     // A Pin turns about z of its frames: align z with the joint axis.
     Eigen::Isometry3d A = Eigen::Isometry3d::Identity();
     A.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), j.axis).toRotationMatrix();

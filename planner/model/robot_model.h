@@ -27,6 +27,9 @@ struct JointInfo {
   int parent_link = -1;
   int child_link = -1;
   Eigen::Vector3d axis;      // in the joint frame (= child link frame)
+  // The joint frame in its parent link's at angle zero (the URDF's origin):
+  // child pose = parent pose * origin * rotation(axis, angle).
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
   double lower = 0, upper = 0;   // rad
   double velocity = 0;       // rad/s
   double effort = 0;         // N m
