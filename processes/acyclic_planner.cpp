@@ -142,9 +142,15 @@ int main(int argc, char** argv) {
     if (s.limb_retries > 0)
       std::printf("acyclic-planner: %ld added contacts tried again with the guide's limb, %ld made so\n",
                   s.limb_retries, s.limb_retry_successes);
+    // A portfolio's stats are its winner's: said so, since the refusal lines
+    // below name every member's.
+    const std::string verifier = r.winner >= 0 && r.winner < static_cast<int>(r.members.size())
+                                     ? " by member \"" + r.members[r.winner].name + "\" (the winner)"
+                                     : std::string();
     if (s.plans_verified > 0)
       std::printf("acyclic-planner: transitions verified: %ld plans checked, %ld refused, %ld transitions solved, "
-                  "%.2f s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds);
+                  "%.2f s%s\n", s.plans_verified, s.plans_refused, s.transitions_solved, s.verify_seconds,
+                  verifier.c_str());
     if (s.nodes_verified > 0)
       std::printf("acyclic-planner: verified before expansion: %ld stances, %ld of them dropped (a transition into "
                   "them cannot be made)\n", s.nodes_verified, s.nodes_refused);
