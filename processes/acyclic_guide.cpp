@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   bool lcm_mode = false;
   std::string url = proc::defaultLcmUrl();
   app.add_option("--in", in, "scenario file (acyclic.scenario/1), file mode");
-  app.add_option("--out", out, "guide file to write (acyclic.guide/1), file mode");
+  app.add_option("--out", out, "guide file to write (acyclic.guide/1), file mode")
+      ->check(acyclic::proc::InWritableDirectory());
   app.add_flag("--lcm", lcm_mode, "serve ACYCLIC_REQUEST on LCM instead of the file mode");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--seed", seed, "seed (default: the scenario's)");

@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   double dt = 0;
   int zmp_stride = 10;
   app.add_option("--in", in, "trajectory file (acyclic.trajectory/1)")->required();
-  app.add_option("--out", out, "basename of the files to write (BASENAME.pos, .waist, .zmp)")->required();
+  app.add_option("--out", out, "basename of the files to write (BASENAME.pos, .waist, .zmp)")
+      ->required()
+      ->check(acyclic::proc::InWritableDirectory());
   app.add_option("--scenario", scenario, "scenario file (default: the one the trajectory names)");
   app.add_option("--config", config_path, "bridge configuration (acyclic.hrp2_bridge/1): dt, margins, stabilizer lead/lag");
   app.add_option("--dt", dt, "controller period, s (default: the configuration's, else 0.005)");

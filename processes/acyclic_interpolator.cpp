@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   bool lcm_mode = false;
   std::string url = acyclic::proc::defaultLcmUrl();
   app.add_option("--in", in, "plan file (acyclic.plan/1), file mode");
-  app.add_option("--out", out, "trajectory file to write (acyclic.trajectory/1), file mode");
+  app.add_option("--out", out, "trajectory file to write (acyclic.trajectory/1), file mode")
+      ->check(acyclic::proc::InWritableDirectory());
   app.add_flag("--lcm", lcm_mode, "serve ACYCLIC_PLAN on LCM instead of the file mode");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--scenario", scenario_path,

@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   acyclic::PlannerOverrides o;
   bool quiet = false;
   app.add_option("--in", in, "scenario file (acyclic.scenario/1), file mode");
-  app.add_option("--out", out, "plan file to write (acyclic.plan/1), file mode");
+  app.add_option("--out", out, "plan file to write (acyclic.plan/1), file mode")
+      ->check(acyclic::proc::InWritableDirectory());
   app.add_option("--guide", guide_path,
                  "key postures from this guide file (acyclic.guide/1, e.g. from acyclic-guide) instead of the "
                  "scenario's, file mode");

@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
   app.add_option("--ipopt", ipopt, "a further Ipopt option NAME=VALUE (repeatable)");
   app.add_option("--out", out,
                  "write the witness as a one-stance plan (acyclic.plan/1) with the stance once the change settles "
-                 "(removed contacts gone, the added one supporting): the input of a next --from");
+                 "(removed contacts gone, the added one supporting): the input of a next --from")
+      ->check(acyclic::proc::InWritableDirectory());
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   try {

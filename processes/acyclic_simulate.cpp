@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_option("scenario", scenario_path, "scenario file (format acyclic.scenario/1)")->required();
   app.add_option("--trajectory", trajectory_path, "trajectory file (format acyclic.trajectory/1)")->required();
-  app.add_option("--report", report_path, "write the report as JSON (format acyclic.simulation/1) to this file");
+  app.add_option("--report", report_path, "write the report as JSON (format acyclic.simulation/1) to this file")
+      ->check(acyclic::proc::InWritableDirectory());
   app.add_option("--slip-bound", o.slip_bound, "a supporting contact slipping more over its phase: slipped, m (default 0.01)");
   app.add_option("--base-bound", o.base_bound, "acceptance: base within this of the plan, m (default 0.02)");
   app.add_option("--settle", o.settle, "hold the last reference this long after the end, s (default 0.5)");
@@ -49,7 +50,8 @@ int main(int argc, char** argv) {
                  "write one CSV row per controller period: time, phase, stabilizer flag, centre of mass and base "
                  "(simulated and planned, world, m), tilt (rad) and as a world rotation vector (its x, y the lean, its z the yaw), "
                  "each spot's vertical force (world z, N), the contact wrenches' ZMP and the stabilizer's wanted one "
-                 "(world x-y, m; nan without load or stabilizer), each sole's turn by the stabilizer (rad)");
+                 "(world x-y, m; nan without load or stabilizer), each sole's turn by the stabilizer (rad)")
+      ->check(acyclic::proc::InWritableDirectory());
   bool open_loop = false;
   app.add_flag("--no-stabilizer", open_loop,
                "play every phase open-loop: no model of HRP-2's stabilizer, even where the bridge runs it (only coplanar feet touch)");
