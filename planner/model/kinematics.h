@@ -30,8 +30,9 @@ class Kinematics {
   // composed along the tree from the joints' origins without Simbody: a
   // tenth of setConfiguration's time, for clearance checks in bulk (the
   // limb path planner's). The poses agree with setConfiguration's to
-  // rounding, not bit for bit, so nothing whose result feeds a search is
-  // built on it. Until the next setConfiguration, the Simbody queries
+  // rounding, not bit for bit: fit for yes-or-no answers against margins
+  // of millimetres, not for the posture generator, whose searches hinge on
+  // the last bits. Until the next setConfiguration, the Simbody queries
   // (Jacobians, centre of mass, gravity torques) throw std::logic_error.
   void setPoses(const Configuration& q);
   const Configuration& configuration() const { return q_; }
