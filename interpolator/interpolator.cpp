@@ -86,6 +86,7 @@ TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
   to.plan_body_path = opt.plan_body_path;
   to.free_limb_paths = opt.free_limb_paths;
   to.limb_joint_paths = opt.limb_joint_paths;
+  to.bridge_jumps = opt.bridge_jumps;
   to.refine_depth = opt.refine_depth;
   to.wide_clearance = opt.wide_clearance;
   to.posture.max_iterations = opt.posture_iterations;

@@ -35,6 +35,9 @@ struct InterpolatorOptions {
   bool limb_joint_paths = true;  // there, a free limb swept through an obstacle on joints planned with OMPL
   double wide_clearance = 0.003;  // m: a fixed-contact transition's last try, its knots this much farther from obstacles
   int refine_depth = 3;
+  // Last, a jump between two branches of the inverse kinematics bridged by
+  // knots from the straight joint-space line across it (transition.h).
+  bool bridge_jumps = true;
   // Check every output sample with the validity contract (and refine where
   // one fails). Off, only knots and segment middles are checked: for
   // measuring what the verification costs, not for output.

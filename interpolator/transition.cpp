@@ -134,6 +134,8 @@ struct TransitionSolver::Attempt {
   std::vector<MotionPiece> pieces;
   // The moving body off its path, as a pendulum's (solve(), last stage).
   bool free_body = false;
+  // Jumps between branches bridged (TransitionOptions::bridge_jumps).
+  bool bridges = false;
 };
 
 struct TransitionSolver::FreeEnd {
@@ -164,17 +166,25 @@ TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options
 namespace {
 
 // A sequence of knots with their path parameters, refined between neighbours
-// whose middle fails the validity check. `solveAt(param, guess)` returns a
-// knot or nothing (with the reason set).
+// whose middle fails the validity check. `solveAt(param, guess, bridge)`
+// returns a knot or nothing (with the reason set): near the witnesses'
+// interpolation at param, or with `bridge` near `guess` alone.
 struct Refiner {
   ValidityChecker& checker;
   const std::vector<ContactSpec>& contacts;
-  std::function<std::optional<Configuration>(double, const Configuration&)> solveAt;
+  std::function<std::optional<Configuration>(double, const Configuration&, bool)> solveAt;
   int depth;
   int* refinements;
   std::string* reason;
 
   int checks;  // points checked inside each segment, equally spaced
+  // Jumps between branches bridged: a segment that no halving along the path
+  // shortens gets knots projected from the straight line between its two
+  // knots (solveAt's `bridge`), halved while they converge, to kMaxBridgeDepth.
+  bool bridges = false;
+  // Per segment of the refined knots: whether it lies on a bridge (its
+  // refinements in verify() are bridge knots too).
+  std::vector<bool> bridged;
 
   bool midValid(const Configuration& a, const Configuration& b, std::string* why) {
     for (int i = 1; i <= checks; ++i) {
@@ -190,28 +200,36 @@ struct Refiner {
   // Appends the refined knots strictly after (pa, a) up to and including (pb, b).
   // `converging`: the halving that made this segment split its parent in two (halved()).
   bool segment(double pa, const Configuration& a, double pb, const Configuration& b, int level,
-               std::vector<Configuration>& out, std::vector<double>& out_params, bool converging = false) {
+               std::vector<Configuration>& out, std::vector<double>& out_params, bool converging = false,
+               bool bridging = false) {
     std::string why;
     if (midValid(a, b, &why)) {
       out.push_back(b);
       out_params.push_back(pb);
+      bridged.push_back(bridging);
       return true;
     }
     // Past `depth` halvings, only while the knots converge (converging()):
     // the drift of a held contact between two knots far apart, which each
     // halving divides by four, wants a few more; a jump between two branches
-    // of the inverse kinematics, which no halving shortens, does not.
+    // of the inverse kinematics, which no halving shortens, does not, unless
+    // bridged: then its knots come from the straight line between the two
+    // knots, and are halved while they converge.
     if (level >= depth && !(level < kMaxDepth && converging)) {
-      *reason = "between two knots, after " + std::to_string(level) + " refinements: " + why;
-      return false;
+      if (!bridges || level >= kMaxBridgeDepth || (bridging && !converging)) {
+        *reason = "between two knots, after " + std::to_string(level) + " refinements" +
+                  (bridging ? " (bridged)" : "") + ": " + why;
+        return false;
+      }
+      bridging = true;
     }
     const double pm = 0.5 * (pa + pb);
-    const std::optional<Configuration> m = solveAt(pm, lerp(a, b, 0.5));
+    const std::optional<Configuration> m = solveAt(pm, lerp(a, b, 0.5), bridging);
     if (!m) return false;
     ++*refinements;
     const bool halves = halved(a, *m, b);
-    return segment(pa, a, pm, *m, level + 1, out, out_params, halves) &&
-           segment(pm, *m, pb, b, level + 1, out, out_params, halves);
+    return segment(pa, a, pm, *m, level + 1, out, out_params, halves, bridging) &&
+           segment(pm, *m, pb, b, level + 1, out, out_params, halves, bridging);
   }
 
   // Whether the knot found in the middle splits the segment into two shorter
@@ -223,12 +241,14 @@ struct Refiner {
            kConverging * whole;
   }
   static constexpr int kMaxDepth = 7;
+  static constexpr int kMaxBridgeDepth = 12;
   static constexpr double kConverging = 0.75;
 
   bool refine(const std::vector<double>& params, const std::vector<Configuration>& knots,
               std::vector<Configuration>& out, std::vector<double>& out_params) {
     out = {knots.front()};
     out_params = {params.front()};
+    bridged.clear();
     for (std::size_t k = 0; k + 1 < knots.size(); ++k)
       if (!segment(params[k], knots[k], params[k + 1], knots[k + 1], 0, out, out_params)) return false;
     return true;
@@ -263,11 +283,13 @@ struct Refiner {
       for (auto it = bad.rbegin(); it != bad.rend(); ++it) {  // from the last, so that indices stay valid
         const int k = *it;
         const double pm = 0.5 * (params[k] + params[k + 1]);
-        const std::optional<Configuration> m = solveAt(pm, lerp(knots[k], knots[k + 1], 0.5));
+        const bool on_bridge = bridged[k];
+        const std::optional<Configuration> m = solveAt(pm, lerp(knots[k], knots[k + 1], 0.5), on_bridge);
         if (!m) return false;
         ++*refinements;
         knots.insert(knots.begin() + k + 1, *m);
         params.insert(params.begin() + k + 1, pm);
+        bridged.insert(bridged.begin() + k + 1, on_bridge);
       }
     }
   }
@@ -319,6 +341,14 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
                               "with the free limbs' joints planned, each knot near its neighbour: "};
         reasons += (reasons.empty() ? "" : "; ") + std::string(what[attempt]) + at.reason;
       }
+    }
+    if (!out.ok && !at.cancelled && opt_.bridge_jumps) {
+      at.pieces.clear();
+      at.bridges = true;
+      out.ok = solveFixed(plan, fd, false, false, {}, at);
+      at.bridges = false;
+      out.repaired = out.ok;
+      if (!out.ok && !at.cancelled) reasons += "; with bridges across branch jumps: " + at.reason;
     }
     if (!out.ok && !at.cancelled) at.reason = reasons;
   } else {
@@ -454,6 +484,19 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       out.repaired = out.ok;
       if (!out.ok && !at.cancelled) reasons += "; the body free in the air, its limb's joints interpolated: " + at.reason;
     }
+    // Last, the path as planned with each jump between two branches of the
+    // inverse kinematics bridged (Refiner::bridges): a right thigh moved
+    // while the left palm is held on the table, whose knots jump 0.006 apart
+    // in path parameter, the palm 1.39 mm into the table between them,
+    // whatever via-point or detour.
+    if (!out.ok && !at.cancelled && opt_.bridge_jumps) {
+      at.pieces.clear();
+      at.bridges = true;
+      out.ok = solveMove(plan, d, path, opt_.air_orientation_tolerance, nullptr, at);
+      at.bridges = false;
+      out.repaired = out.ok;
+      if (!out.ok && !at.cancelled) reasons += "; as planned, with bridges across branch jumps: " + at.reason;
+    }
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
   }
@@ -506,7 +549,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   if (distance(q0, q1) < 1e-9) return true;  // the witnesses coincide: only the contacts' support changes
-  auto solveAt = [&](double alpha, const Configuration& guess) -> std::optional<Configuration> {
+  auto solveAt = [&](double alpha, const Configuration& guess, bool bridge) -> std::optional<Configuration> {
     if (at.cancel && at.cancel->load()) {
       at.cancelled = true;
       at.reason = "cancelled";
@@ -518,7 +561,9 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
     Configuration ref = lerp(q0, q1, alpha);
     for (const auto& l : limbs) ref = l.apply(ref, alpha);
     Configuration target = ref;
-    if (follow) {
+    if (bridge) {
+      target = guess;  // a bridge knot: the straight line between its neighbours
+    } else if (follow) {
       // Planned limbs on their paths even when following the previous knot (solveMove).
       target = lerp(guess, ref, 0.5);
       for (const auto& l : limbs) target = l.apply(target, alpha);
@@ -548,7 +593,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   std::vector<Configuration> knots{q0};
   for (int i = 1; i < steps; ++i) {
     const double alpha = static_cast<double>(i) / steps;
-    const auto k = solveAt(alpha, knots.back());
+    const auto k = solveAt(alpha, knots.back(), false);
     if (!k) return false;
     params.push_back(alpha);
     knots.push_back(*k);
@@ -558,7 +603,8 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   MotionPiece piece;
   piece.contacts = d.motion_contacts;
   piece.stance = d.motion_stance;
-  Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks};
+  Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks,
+              at.bridges, {}};
   std::vector<double> piece_params;
   if (!ref.refine(params, knots, piece.knots, piece_params)) return false;
   if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;
@@ -700,7 +746,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
   const double touch_clearance = pendulum ? kPendulumTouch : opt_.touch_clearance;
   const double s0 = path.leaveParameter(touch_clearance), s1 = path.arriveParameter(touch_clearance);
   bool loose_only = false;
-  auto solveAt = [&](double s, const Configuration& guess) -> std::optional<Configuration> {
+  auto solveAt = [&](double s, const Configuration& guess, bool bridge) -> std::optional<Configuration> {
     if (at.cancel && at.cancel->load()) {
       at.cancelled = true;
       at.reason = "cancelled";
@@ -724,8 +770,10 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     // optimum jumped to the far side of the table's edge between two knots
     // (0.12 rad at s = 0.4008 of a chair plan's transition), which no
     // refinement closes. Its path is continuous in s already.
-    Configuration target = lerp(guess, ref, 0.5);
-    if (free_ends)
+    // A bridge knot (Refiner::bridges) is near the straight line between its
+    // neighbours alone.
+    Configuration target = bridge ? guess : lerp(guess, ref, 0.5);
+    if (free_ends && !bridge)
       for (const auto& f : *free_ends)
         if (f.joints) target = f.joints->apply(target, s);
     const auto cost = std::make_shared<ReferencePostureCost>(target, 1.0, 10.0, 1.0, free_targets);
@@ -837,7 +885,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     } else if (i + 1 == params.size() && !d.arrive) {
       knots.push_back(q1);
     } else {
-      const auto k = solveAt(params[i], knots.empty() ? q0 : knots.back());
+      const auto k = solveAt(params[i], knots.empty() ? q0 : knots.back(), false);
       if (!k) return false;
       knots.push_back(*k);
     }
@@ -847,7 +895,8 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     MotionPiece piece;
     piece.contacts = contacts;
     piece.stance = stance;
-    Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks};
+    Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks,
+                at.bridges, {}};
     std::vector<double> piece_params;
     if (!ref.refine(ps, ks, piece.knots, piece_params)) return false;
     if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;

@@ -121,6 +121,13 @@ struct TransitionOptions {
   // little more room takes the dip.
   double wide_clearance = 0.003;
   int refine_depth = 3;              // halvings of a segment whose inside fails the check
+  // Last, where every attempt stopped at a jump between two branches of the
+  // inverse kinematics (two knots close in path parameter, far apart in
+  // joint space, a held contact drifting off its surface between them): the
+  // attempt as planned again, each such jump bridged by knots projected from
+  // the straight joint-space segment between its two knots, halved while
+  // they converge (Refiner in transition.cpp).
+  bool bridge_jumps = true;
   int segment_checks = 1;            // points checked inside each segment before timing (its middle)
   // After timing, every sample the piece will give is checked, and refined
   // where one fails (with timing: the time law the interpolator uses).

@@ -1026,6 +1026,33 @@ TEST(Interpolator, AnArmHangingBehindThePelvisIsSwungUpOntoTheTable) {
   expectPaperChairPieceInterpolates("chair_paper_arm_from_behind_onto_table.plan.json");
 }
 
+TEST(Interpolator, AJumpBetweenBranchesOfTheInverseKinematicsIsBridged) {
+  // chair_paper on its OMPL guide (acyclic-guide), stances 7 -> 8 of the
+  // portfolio's 572-node plan: the right thigh leaves the seat while the left
+  // palm and the right wrist are held on the table and both soles on the
+  // floor. Between two knots 0.006 apart in path parameter the knots'
+  // optimum jumps from one branch of the inverse kinematics to another, the
+  // palm 1.39 mm into the table between them: no halving shortens the jump,
+  // and every via-point and detour fails the same way or finds no posture.
+  // That refused the plan. Bridged, the jump gets knots projected from the
+  // straight joint-space line between its two knots, and every sample is
+  // valid.
+  const Scenario& sc = paperChairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair_paper_ompl_palm_held_branch_jump.plan.json"), sc);
+  ASSERT_EQ(plan.stances.size(), 2u);
+  InterpolatorOptions opt;
+  opt.filter = false;
+  opt.bridge_jumps = false;
+  const InterpolationResult without = interpolate(plan, sc, opt);
+  ASSERT_FALSE(without.success());
+  EXPECT_NE(without.reason.find("between two knots"), std::string::npos) << without.reason;
+  EXPECT_NE(without.reason.find("table_top"), std::string::npos) << without.reason;
+  opt.bridge_jumps = true;
+  const InterpolationResult r = interpolate(plan, sc, opt);
+  ASSERT_TRUE(r.success()) << toString(r.status) << ": " << r.reason;
+  expectValid(r.trajectory, sc);
+}
+
 TEST(Interpolator, BadInputAndCancellation) {
   const Scenario& sc = floorScenario();
   Plan plan = stepPlan(sc, 0.15);
