@@ -301,6 +301,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   TransitionOutcome out;
   Attempt at;
   at.cancel = cancel;
+  planned_limbs_.clear();
   // A body that only reaches (or only leaves) a surface and already touches
   // it where the other witness has it (a wrist laid on the table beside the
   // forearm already there, as the witness placed it) does not move: the
@@ -470,7 +471,8 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     // whichever via-point).
     if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths && opt_.limb_joint_paths &&
         onFreeLimb(d)) {
-      std::vector<FreeEnd> limbs = withPlannedJoints(plan, d, freeEnds(plan, d));
+      // `free`: freeEnds', found for the stage with the free limbs on their own paths (run whenever this one is).
+      std::vector<FreeEnd> limbs = withPlannedJoints(plan, d, free);
       const Configuration& q0 = plan.stances[d.from].configuration;
       const Configuration& q1 = plan.stances[d.to].configuration;
       const int root = sc_.robot->spotLimbRootJoint(d.spot);
@@ -689,6 +691,19 @@ std::vector<int> TransitionSolver::freeLimbEnds(const TransitionDesign& d) const
 // that hug an obstacle, and the interpolation between them dips below it).
 std::optional<LimbJointPath> TransitionSolver::plannedLimbJoints(const Configuration& q0, const Configuration& q1,
                                                                  int root, bool touching_ends) {
+  auto same = [](const Configuration& a, const Configuration& b) {
+    return a.base_position == b.base_position && a.base_orientation.coeffs() == b.base_orientation.coeffs() &&
+           a.joints == b.joints;
+  };
+  for (const PlannedLimb& p : planned_limbs_)
+    if (p.root == root && p.touching_ends == touching_ends && same(p.q0, q0) && same(p.q1, q1)) return p.path;
+  std::optional<LimbJointPath> path = planLimbJoints(q0, q1, root, touching_ends);
+  planned_limbs_.push_back({q0, q1, root, touching_ends, path});
+  return path;
+}
+
+std::optional<LimbJointPath> TransitionSolver::planLimbJoints(const Configuration& q0, const Configuration& q1, int root,
+                                                              bool touching_ends) {
   LimbPathPlanOptions lo;
   lo.touching_ends = touching_ends;
   if (limbSweepClearance(collisions_, kin_, root, q0, q1, lo.clearance) >= 0.5 * lo.clearance) return std::nullopt;

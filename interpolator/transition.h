@@ -179,6 +179,9 @@ class TransitionSolver {
   // `touching_ends`: LimbPathPlanOptions::touching_ends (the limb's own body on its surface).
   std::optional<LimbJointPath> plannedLimbJoints(const Configuration& q0, const Configuration& q1, int root,
                                                  bool touching_ends = false);
+  // The same, planned anew (plannedLimbJoints remembers its answers).
+  std::optional<LimbJointPath> planLimbJoints(const Configuration& q0, const Configuration& q1, int root,
+                                              bool touching_ends);
   // Whether the Move's body is on a limb that holds no contact during the motion (a forearm, its arm free).
   bool onFreeLimb(const TransitionDesign& d) const;
   // A Move whose body already touches its surface in both witnesses, as the
@@ -189,6 +192,17 @@ class TransitionSolver {
   bool hangsFromItsLimb(const TransitionDesign& d) const;
   // The shapes of the links outside `spot`'s limb at q (all but its link, for a spot on the trunk).
   std::vector<PlacedShape> outsideLimb(const Configuration& q, int spot);
+
+  // plannedLimbJoints' answers within one solve(): the later repair stages
+  // ask for the same limbs between the same witnesses again, and a limb with
+  // no path costs seconds of state checks each time (its five tries).
+  struct PlannedLimb {
+    Configuration q0, q1;
+    int root;
+    bool touching_ends;
+    std::optional<LimbJointPath> path;
+  };
+  std::vector<PlannedLimb> planned_limbs_;
 
   const Scenario& sc_;
   TransitionOptions opt_;

@@ -847,6 +847,43 @@ TEST(QuasiStaticCheck, VerdictsWithoutTheMarginLpAgreeWithFullChecks) {
   EXPECT_GT(torque_bound, 0);
 }
 
+// The checker takes each corner's Jacobian from one frame Jacobian of its
+// contact (J_p = J_v - [p - o]x J_w): the forces it reports, mapped through
+// Simbody's own station Jacobian at each reported corner, balance gravity on
+// the base and stay within every joint's torque limit, with the torque ratio
+// it reports. A wrong row, sign or lever arm gives forces that balance a
+// different robot.
+TEST(QuasiStaticCheck, ReportedForcesBalanceGravityThroughStationJacobians) {
+  const Scenario& sc = chair();
+  const RobotModel& m = *sc.robot;
+  QuasiStaticChecker checker(sc.robot, sc.scene);
+  Kinematics k(sc.robot);
+  const double W = m.totalMass() * 9.81;
+  int feasible = 0;
+  forEachChairPlanCheck(sc, [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
+    k.setConfiguration(q);
+    const QuasiStaticReport r = checker.check(k, stance);
+    if (!r.feasible) return;
+    ++feasible;
+    Eigen::VectorXd tau = k.gravityTorques();
+    double levers = 0;  // the corners' distance from their links' origins: the moments depend on them
+    for (std::size_t c = 0; c < stance.size(); ++c) {
+      const int link = m.spots()[stance[c].spot].link;
+      for (std::size_t i = 0; i < r.points[c].size(); ++i) {
+        const Eigen::Vector3d in_link = k.linkPose(link).inverse() * r.points[c][i];
+        tau -= k.pointJacobian(link, in_link).transpose() * r.forces[c][i];
+        levers = std::max(levers, in_link.norm());
+      }
+    }
+    EXPECT_GT(levers, 0.01);
+    EXPECT_LE(tau.head<6>().norm() / W, 1e-6) << feasible;
+    double worst = 0;
+    for (const auto& j : m.joints()) worst = std::max(worst, std::abs(tau[6 + j.index]) / j.effort);
+    EXPECT_NEAR(worst, r.worst_torque_ratio, 1e-6) << feasible;
+  });
+  EXPECT_GT(feasible, 50);
+}
+
 // --- Friction: the pyramid inscribed in the Coulomb cone --------------------
 
 namespace {

@@ -119,6 +119,12 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     const ContactSpot& spot = m.spots()[c.spot];
     const Surface& s = scene_->surfaces()[c.surface];
     const Eigen::Isometry3d Tspot = kin.spotPose(c.spot);
+    // One frame Jacobian at the spot's origin (Simbody) gives every corner's:
+    // v_p = v_o + w x (p - o), so each column of J_p is J_v's plus J_w's
+    // x (p - o). Half the passes of a station Jacobian per corner, in the
+    // check that every sample of a trajectory pays.
+    const Eigen::MatrixXd Jo = kin.frameJacobian(spot.link, spot.frame.translation());  // rows: linear, angular
+    const Eigen::Matrix<double, 3, Eigen::Dynamic> Jw = Jo.bottomRows<3>();
     for (const auto& v : spot.polygon.vertices()) {
       Corner k;
       k.contact = static_cast<int>(ci);
@@ -128,7 +134,7 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
       k.t1 = s.frame.linear().col(0);
       k.t2 = s.frame.linear().col(1);
       k.mu = s.friction;
-      k.JT = kin.pointJacobian(spot.link, spot.frame * in_spot).transpose();
+      k.JT = (Jo.topRows<3>() + Jw.colwise().cross(k.p - Tspot.translation())).transpose();
       corners.push_back(k);
     }
   }
