@@ -53,6 +53,11 @@ int main(int argc, char** argv) {
   app.add_option("--penetration", o.penetration, "robot-scene penetration allowed along the guide, m")
       ->capture_default_str();
   app.add_option("--range", o.range, "RRTConnect range in the reduced space")->capture_default_str();
+  app.add_option("--path-tries", o.path_tries,
+                 "each leg's path the shortest of this many RRTConnect tries (the first with the seed, the others\n"
+                 "with seeds derived from it, each bounded by state checks): less of one random tree's luck")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   bool no_crouch = false;
   app.add_flag("--no-crouch", no_crouch, "standing postures only: no second try with a crouch");
   bool no_crawl = false;

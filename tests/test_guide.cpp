@@ -235,6 +235,43 @@ TEST(GuideAuthor, SameScenarioAndSeedSameGuide) {
   EXPECT_EQ(guideToJson(ga, sc), guideToJson(gb, sc));
 }
 
+// GuideOptions::path_tries: one RRTConnect try leaves chair_paper's guide to
+// one random tree's luck. Seed 2 finds no path within its 50,000 state checks
+// (the fallback bound of a leg that a crouch may follow); seed 3's path first
+// goes right, behind the chair and round it (x -0.43 m), where the goal is on
+// the left. The shortest of four tries finds a path for both and goes left
+// between the chair and the table each time, the same guide again for the
+// same seed (the tries are bounded by state checks, not time).
+TEST(GuideAuthor, TheShortestOfSeveralTriesIsLessOneTreesLuck) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
+  GuideOptions one;
+  one.max_seconds = 60;  // the check bounds decide, not a loaded machine
+  GuideOptions four = one;
+  four.path_tries = 4;
+  auto lowestY = [](const Guide& g) {
+    double y = 1e9;
+    for (const auto& q : g.key_postures) y = std::min(y, q.base_position.y());
+    return y;
+  };
+  one.seed = four.seed = 2;
+  const GuideResult lost = authorGuide(sc, one);
+  EXPECT_EQ(lost.status, GuideResult::Status::NoPath) << lost.reason;
+  const GuideResult found = authorGuide(sc, four);
+  ASSERT_TRUE(found.success()) << found.reason;
+  EXPECT_GT(lowestY(found.guide), -0.05);
+  one.seed = four.seed = 3;
+  const GuideResult round = authorGuide(sc, one);
+  ASSERT_TRUE(round.success()) << round.reason;
+  EXPECT_LT(lowestY(round.guide), -0.2);  // the long way, right of the chair
+  const GuideResult a = authorGuide(sc, four), b = authorGuide(sc, four);
+  ASSERT_TRUE(a.success() && b.success()) << a.reason << " | " << b.reason;
+  EXPECT_GT(lowestY(a.guide), -0.05);
+  EXPECT_LT(a.guide.key_postures.size(), round.guide.key_postures.size());
+  Guide ga = a.guide, gb = b.guide;
+  ga.seconds = gb.seconds = 0;
+  EXPECT_EQ(guideToJson(ga, sc), guideToJson(gb, sc));
+}
+
 TEST(GuideAuthor, GuidePlansTheSmallScenarioToAValidPlan) {
   const Scenario base = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml"));
   const GuideResult g = authorGuide(base, GuideOptions());

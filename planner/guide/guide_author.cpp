@@ -777,8 +777,10 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     b.setHigh(k, 1.0);
   }
   space->setBounds(b);
-  const unsigned seed = o.seed;
-  space->setStateSamplerAllocator([seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  // The seed of the try being made (GuideOptions::path_tries): read when a
+  // try's planner allocates its sampler.
+  auto seed = std::make_shared<unsigned>(o.seed);
+  space->setStateSamplerAllocator([seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, *seed); });
   og::SimpleSetup ss(space);
   auto si = ss.getSpaceInformation();
   auto validity = std::make_shared<RelaxedValidity>(si, sc, lift, o.penetration);
@@ -818,13 +820,12 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     }
   }
   ss.setStartAndGoalStates(start, target);
-  auto planner = std::make_shared<SeededRRTConnect>(si, seed);
-  planner->setRange(o.range);
-  ss.setPlanner(planner);
-  ss.setup();
   const double t1 = now();
+  long try_checks = max_checks;  // the try's own bound on state checks (0: none), from its first check
+  long checks0 = 0;
   const auto stop = [&] {
-    return now() - t1 > budget || (max_checks > 0 && validity->checks() >= max_checks) || (cancel && cancel->load());
+    return now() - t1 > budget || (try_checks > 0 && validity->checks() - checks0 >= try_checks) ||
+           (cancel && cancel->load());
   };
   const auto cancelled = [&] {
     if (!cancel || !cancel->load()) return false;
@@ -833,27 +834,66 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     return true;
   };
   std::string unprojected;  // why the last path left the statically stable subspace (GuideOptions::stable)
-  for (int attempt = 0;; ++attempt) {
+  // One try: RRTConnect seeded with `try_seed`, its path shortcut; none
+  // without an exact solution (`checks_out`: stopped on its check bound).
+  // The first try's planner is kept across the replans (cleared, not seeded
+  // again) and counts its checks from the leg's first, as a single try did.
+  std::shared_ptr<SeededRRTConnect> first;
+  const auto tryPath = [&](int t, bool& checks_out) -> std::optional<og::PathGeometric> {
+    const unsigned try_seed = o.seed + 7919u * static_cast<unsigned>(t);
+    *seed = try_seed;
+    std::shared_ptr<SeededRRTConnect> planner = t == 0 ? first : nullptr;
+    if (planner) {
+      planner->clear();
+    } else {
+      planner = std::make_shared<SeededRRTConnect>(si, try_seed);
+      planner->setRange(o.range);
+      if (t == 0) first = planner;
+    }
+    ss.setPlanner(planner);
+    ss.getProblemDefinition()->clearSolutionPaths();
+    ss.setup();
+    checks0 = t == 0 ? 0 : validity->checks();
     const double t2 = now();
     const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition(stop));
     out.path_seconds += now() - t2;
+    checks_out = try_checks > 0 && validity->checks() - checks0 >= try_checks;
+    if (st != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
+    og::PathGeometric path = ss.getSolutionPath();
+    out.path_vertices += static_cast<int>(path.getStateCount());
+    SeededSimplifier simplifier(si, try_seed);
+    simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+    simplifier.shortcutPath(path, static_cast<unsigned>(o.shortcut_steps));
+    simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+    return path;
+  };
+  for (int attempt = 0;; ++attempt) {
+    // GuideOptions::path_tries: the shortest of that many tries, each seeded
+    // anew (the first with the guide's seed), the first on a tie; the tries
+    // after the first bounded by state checks (fallback_checks where the leg
+    // has no such bound), so that the choice is the same under any load.
+    std::optional<og::PathGeometric> best;
+    bool checks_out = false;
+    for (int t = 0; t < std::max(1, o.path_tries) && !(cancel && cancel->load()); ++t) {
+      try_checks = t == 0 || max_checks > 0 ? max_checks : o.fallback_checks;
+      bool out_of_checks = false;
+      std::optional<og::PathGeometric> p = tryPath(t, out_of_checks);
+      if (t == 0) checks_out = out_of_checks;
+      if (p && (!best || p->length() < best->length() - 1e-12)) best = std::move(p);
+      if (now() - t1 > budget) break;
+    }
     if (cancelled()) return false;
-    if (st != ob::PlannerStatus::EXACT_SOLUTION) {
+    if (!best) {
       out.status = GuideResult::Status::NoPath;
       out.reason = "OMPL (RRTConnect) found no path to the " + what +
-                   (max_checks > 0 && validity->checks() >= max_checks ? fmt(" within %.0f state checks", max_checks)
-                                                                        : fmt(" within %.1f s", budget));
+                   (checks_out ? fmt(" within %.0f state checks", max_checks) : fmt(" within %.1f s", budget));
+      if (o.path_tries > 1) out.reason += fmt(" in %.0f tries", o.path_tries);
       if (attempt > 0)
         out.reason += fmt(" through the statically stable subspace (%.0f replans around samples that did not project; "
                           "the last: ", attempt) + unprojected + ")";
       return false;
     }
-    og::PathGeometric path = ss.getSolutionPath();
-    out.path_vertices += static_cast<int>(path.getStateCount());
-    SeededSimplifier simplifier(si, seed);
-    simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
-    simplifier.shortcutPath(path, static_cast<unsigned>(o.shortcut_steps));
-    simplifier.reduceVertices(path, static_cast<unsigned>(o.shortcut_steps));
+    og::PathGeometric& path = *best;
     // The vertices, or with GuideOptions::stable (or sample_edges) samples along the edges:
     // at most stable_step of base travel, 0.2 rad of heading, 0.1 of blend
     // or crouch apart.

@@ -64,6 +64,13 @@ struct GuideOptions {
   double stable_tolerance = 0.1;  // m: a projection's base this near the sample's, horizontally
   int stable_replans = 4;
   double stable_forbid = 0.1;   // the left-out ball's radius in the reduced space's metric
+  // Each leg's path: the shortest (in the reduced space's metric, once
+  // shortcut) of this many RRTConnect tries, the first with `seed`, the
+  // others with seeds derived from it. One try leaves the guide to one
+  // random tree's luck: on chair_paper some seeds find no path within
+  // fallback_checks or go round the chair the long way (docs/design.md
+  // section 7).
+  int path_tries = 1;
   unsigned seed = 1;
 };
 
