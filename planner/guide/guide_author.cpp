@@ -835,11 +835,11 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
   };
   std::string unprojected;  // why the last path left the statically stable subspace (GuideOptions::stable)
   // One try: RRTConnect seeded with `try_seed`, its path shortcut; none
-  // without an exact solution (`checks_out`: stopped on its check bound).
+  // without an exact solution.
   // The first try's planner is kept across the replans (cleared, not seeded
   // again) and counts its checks from the leg's first, as a single try did.
   std::shared_ptr<SeededRRTConnect> first;
-  const auto tryPath = [&](int t, bool& checks_out) -> std::optional<og::PathGeometric> {
+  const auto tryPath = [&](int t) -> std::optional<og::PathGeometric> {
     const unsigned try_seed = o.seed + 7919u * static_cast<unsigned>(t);
     *seed = try_seed;
     std::shared_ptr<SeededRRTConnect> planner = t == 0 ? first : nullptr;
@@ -857,7 +857,6 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     const double t2 = now();
     const ob::PlannerStatus st = ss.solve(ob::PlannerTerminationCondition(stop));
     out.path_seconds += now() - t2;
-    checks_out = try_checks > 0 && validity->checks() - checks0 >= try_checks;
     if (st != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
     og::PathGeometric path = ss.getSolutionPath();
     out.path_vertices += static_cast<int>(path.getStateCount());
@@ -873,12 +872,11 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     // after the first bounded by state checks (fallback_checks where the leg
     // has no such bound), so that the choice is the same under any load.
     std::optional<og::PathGeometric> best;
-    bool checks_out = false;
+    bool checks_out = false;  // the first try stopped on its check bound (the leg's, counted from its first check)
     for (int t = 0; t < std::max(1, o.path_tries) && !(cancel && cancel->load()); ++t) {
       try_checks = t == 0 || max_checks > 0 ? max_checks : o.fallback_checks;
-      bool out_of_checks = false;
-      std::optional<og::PathGeometric> p = tryPath(t, out_of_checks);
-      if (t == 0) checks_out = out_of_checks;
+      std::optional<og::PathGeometric> p = tryPath(t);
+      if (t == 0) checks_out = max_checks > 0 && validity->checks() >= max_checks;
       if (p && (!best || p->length() < best->length() - 1e-12)) best = std::move(p);
       if (now() - t1 > budget) break;
     }
