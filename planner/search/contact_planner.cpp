@@ -148,6 +148,14 @@ struct ContactPlanner::Impl {
   ContactPlanner::Progress progress;  // the caller's, also told when a verification starts
   const std::atomic<bool>* cancel = nullptr;  // checked before every posture call
   ContactPlanner::MemberLink* link = nullptr;  // as a member of a portfolio
+  // Calls of a batch solved but not yet taken in their turn (solveAll adds
+  // them to posture_calls at once; taken() or notUsed() settles each).
+  long pending_calls = 0;
+  // The posture calls of the search made one call at a time, up to here:
+  // what a portfolio compares (a batch's calls solved ahead of their turn
+  // left out until it comes; those exporting a goal's plan left out, so that
+  // a member's count stays the one it announced while it verifies that goal).
+  long sequentialCalls() const { return stats.searchCalls() - pending_calls; }
   bool deferred = false;  // the last verification was stopped for a better goal another member verifies
   PlanningResult::Status stop = PlanningResult::Status::NoSolution;
   std::string stop_reason;
@@ -178,16 +186,20 @@ struct ContactPlanner::Impl {
   }
   double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
-  // A portfolio's member past the count another solved in cannot win.
-  bool outrun(long nodes) const { return link && link->outrun(nodes); }
+  // A portfolio's member past the posture calls another solved in cannot win.
+  bool outrun(long calls) const { return link && link->outrun(calls); }
   void stopOutrun() {
     stop = PlanningResult::Status::Cancelled;
     stop_reason = "outrun: another member of the portfolio solved, and this one is past " +
-                  std::to_string(link->cap()) + " nodes";
+                  std::to_string(link->cap()) + " posture calls";
   }
 
   bool budgetLeft() {
-    if (outrun(stats.nodes_generated)) {
+    // While another member verifies a goal this one cannot beat, wait here,
+    // within an expansion too (one of chair_paper's made 132 nodes): its core
+    // is the verifier's, and waiting changes nothing in this search.
+    if (link) link->gate(sequentialCalls(), [&] { return (cancel && cancel->load()) || elapsed() > p.max_seconds; });
+    if (outrun(sequentialCalls())) {
       stopOutrun();
       return false;
     }
@@ -362,16 +374,23 @@ struct ContactPlanner::Impl {
     for (std::size_t i = 0; i < rs.size(); ++i)
       if (b.ran[i]) {
         stats.posture_calls += b.results[i].solves;  // a retry is a call
+        pending_calls += b.results[i].solves;
         if (!b.results[i].success()) ++stats.posture_failures;
         if (b.results[i].solves > 1) ++stats.limb_retries, stats.limb_retry_successes += b.results[i].success();
       }
     return b;
   }
 
+  // A batch's result taken in its turn: a call of the sequential search.
+  void taken(const Batch& b, std::size_t i) {
+    if (b.ran[i]) pending_calls -= b.results[i].solves;
+  }
+
   // A batch's result that the search does not take (solved ahead, its turn
   // never came): counted apart from the posture calls.
   void notUsed(const Batch& b, std::size_t i) {
     if (!b.ran[i]) return;
+    pending_calls -= b.results[i].solves;
     stats.posture_calls -= b.results[i].solves;
     if (b.results[i].solves > 1) --stats.limb_retries, stats.limb_retry_successes -= b.results[i].success();
     if (!b.results[i].success()) --stats.posture_failures;
@@ -585,6 +604,7 @@ struct ContactPlanner::Impl {
           if (k + 1 < cands.size()) giveBack(k + 1);
           return -1;
         }
+        taken(b, k);
         const int id = acceptCandidate(gi, cands[k], b.results[k]);
         if (id >= 0 || b.results[k].success()) {
           if (k + 1 < cands.size()) giveBack(k + 1);
@@ -666,6 +686,7 @@ struct ContactPlanner::Impl {
       const Batch b = solveAll(requests);
       for (std::size_t k = 0; k < requests.size() && goal_node < 0; ++k)
         if (b.ran[k]) acceptRemoval(ni, removed[k], requests[k], b.results[k]);
+      for (std::size_t k = 0; k < requests.size(); ++k) taken(b, k);  // every one counted, as the ablation always did
     }
     const std::vector<int> pairs = pairGenerators(ni);
     const int sons = p.optimized_candidates ? p.eager_candidates_per_pair : p.random_samples_per_pair;
@@ -717,13 +738,14 @@ struct ContactPlanner::Impl {
     const Batch b = solveAll(requests);
     std::vector<char> used(requests.size(), 0);
     for (std::size_t k = 0; k < n_removals && goal_node < 0; ++k)
-      if (b.ran[k]) acceptRemoval(ni, removed[k], requests[k], b.results[k]), used[k] = 1;
+      if (b.ran[k]) taken(b, k), acceptRemoval(ni, removed[k], requests[k], b.results[k]), used[k] = 1;
     if (budgetLeft() && goal_node < 0) {
       for (std::size_t j = 0; j < with_candidate.size() && goal_node < 0; ++j) {
         const std::size_t r = n_removals + j;
         if (!b.ran[r]) break;  // cancelled, or out of posture calls
         const int k = with_candidate[j];
         used[r] = 1;
+        taken(b, r);
         if (acceptCandidate(pairs[k], cands[k], b.results[r]) < 0 && b.results[r].success()) nextSon(pairs[k]);
       }
     }
@@ -731,6 +753,7 @@ struct ContactPlanner::Impl {
       const std::size_t r = requests.size() - 1;
       if (budgetLeft() && goal_node < 0 && b.ran[r]) {
         used[r] = 1;
+        taken(b, r);
         if (acceptCandidate(selected_from, next, b.results[r]) < 0) nextSon(selected_from);
       } else {
         gens[selected_from] = *before;
@@ -761,7 +784,9 @@ struct ContactPlanner::Impl {
         ++stats.posture_calls;
         if (!res.success()) ++stats.posture_failures;
       } else {
-        res = solveAll({r}, false).results[0];
+        const Batch one = solveAll({r}, false);
+        taken(one, 0);
+        res = one.results[0];
       }
       if (res.success() && valid(res.configuration)) return res.configuration;
       return std::nullopt;
@@ -869,12 +894,12 @@ struct ContactPlanner::Impl {
       stats.verifying = false;
     }
     std::atomic<bool> stop_flag{false}, done{false}, beaten{false};
-    const long nodes_now = stats.nodes_generated;
+    const long calls_now = sequentialCalls();
     std::thread watch([&] {
       while (!done.load()) {
-        if ((cancel && cancel->load()) || elapsed() > p.max_seconds || outrun(nodes_now)) stop_flag = true;
+        if ((cancel && cancel->load()) || elapsed() > p.max_seconds || outrun(calls_now)) stop_flag = true;
         // A portfolio's member beaten by a goal another verifies defers its own (verifyPath).
-        if (announce && link && link->beaten(nodes_now)) beaten = stop_flag = true;
+        if (announce && link && link->beaten(calls_now)) beaten = stop_flag = true;
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
     });
@@ -910,7 +935,10 @@ struct ContactPlanner::Impl {
   enum class Verified { Ok, Dropped, Stopped, Deferred };
   Verified verifyPath(int node, Plan& plan, PlanningResult& out, bool goal) {
     while (true) {
-      if (!exportPlan(node, plan)) {
+      const long before_export = stats.posture_calls;
+      const bool exported = exportPlan(node, plan);
+      stats.export_calls += stats.posture_calls - before_export;
+      if (!exported) {
         ++stats.check_refusals;
         return Verified::Dropped;
       }
@@ -1000,8 +1028,8 @@ PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Pro
     if (link) {
       // While another member verifies a goal this one cannot beat, its
       // core is the verifier's (waiting changes nothing in this search).
-      link->gate(I.stats.nodes_generated, [&] { return (cancel && cancel->load()) || I.elapsed() > I.p.max_seconds; });
-      if (I.outrun(I.stats.nodes_generated)) {
+      link->gate(I.sequentialCalls(), [&] { return (cancel && cancel->load()) || I.elapsed() > I.p.max_seconds; });
+      if (I.outrun(I.sequentialCalls())) {
         I.stopOutrun();
         break;
       }
@@ -1010,7 +1038,7 @@ PlanningResult ContactPlanner::search(const std::atomic<bool>* cancel, const Pro
       // A goal whose plan cannot be exported (a settled stance without a
       // valid witness) or whose transitions cannot all be made is dropped
       // with the node where it fails; the search goes on.
-      if (link) link->verifying(I.stats.nodes_generated);
+      if (link) link->verifying(I.sequentialCalls());
       const Impl::Verified v = I.verifyPath(I.goal_node, plan, out, true);
       if (v == Impl::Verified::Ok) {
         exported = true;  // still "verifying" for the others until the portfolio sets their caps

@@ -136,8 +136,9 @@ struct PlannerParameters {
   // empty, plan() runs one search per variant at once, each on these
   // parameters with the variant applied and threads / members posture
   // generators, and returns the plan of the member that solved in the
-  // fewest nodes generated (ties: the earlier member). A member stops as
-  // soon as it has generated more nodes than a member that solved, so the
+  // fewest posture calls (PlanningStats::searchCalls; ties: the earlier
+  // member). A member stops as soon as it has made more calls than a member
+  // that solved, so the
   // winner does not depend on the members' speeds: the same plan as that
   // member run alone, whatever the timing. The counts of a search hinge on
   // the last bits of its witnesses (bench_sensitivity); members that differ
@@ -150,6 +151,11 @@ struct PlanningStats {
   long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
   long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
   long calls_ahead_unused = 0;  // solved ahead on an idle generator, their turn never came (not in posture_calls)
+  // Of posture_calls, those made exporting plans found (witnesses of the
+  // settled stances between a removal and an addition).
+  long export_calls = 0;
+  // The calls of the search itself: what a portfolio compares its members by.
+  long searchCalls() const { return posture_calls - export_calls; }
   // guide_limb_guess: added contacts solved again from the guide's limb, and
   // how many of those the retry made (both within posture_calls).
   long limb_retries = 0, limb_retry_successes = 0;
@@ -175,7 +181,7 @@ struct RefusedPlan {
 struct PlanningResult {
   enum class Status { Solved, NoSolution, NodeBudget, PostureBudget, TimeLimit, Cancelled, InvalidInput };
   // How one member of a portfolio ended (a member that stopped because
-  // another solved in fewer nodes: Cancelled, "outrun ...").
+  // another solved in fewer posture calls: Cancelled, "outrun ...").
   struct Member {
     std::string name;
     Status status = Status::InvalidInput;
@@ -219,7 +225,7 @@ class ContactPlanner {
   struct Portfolio;   // one ContactPlanner per member (portfolio.h)
   struct MemberLink;  // a member's view of its portfolio (portfolio.h)
   // One search; as a member of a portfolio (link), it stops (Cancelled)
-  // once it has generated more nodes than another member solved in, and
+  // once it has made more posture calls than another member solved in, and
   // waits while another verifies a goal it cannot beat.
   PlanningResult search(const std::atomic<bool>* cancel, const Progress& progress, MemberLink* link);
   std::unique_ptr<Impl> impl_;            // without a portfolio

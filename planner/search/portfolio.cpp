@@ -25,6 +25,7 @@ PlanningStats combined(const std::vector<PlanningStats>& all) {
     s.check_refusals += m.check_refusals;
     s.pairs_remembered += m.pairs_remembered;
     s.calls_ahead_unused += m.calls_ahead_unused;
+    s.export_calls += m.export_calls;
     s.limb_retries += m.limb_retries;
     s.limb_retry_successes += m.limb_retry_successes;
     s.plans_verified += m.plans_verified;
@@ -48,12 +49,13 @@ PlanningStats combined(const std::vector<PlanningStats>& all) {
 struct PortfolioState {
   std::mutex lock;
   std::condition_variable changed;  // a cap lowered, a verification ended, a member finished
-  std::vector<long> caps, goals;    // goals: the count of a goal being verified, LONG_MAX: none
+  // Counts of posture calls. goals: the count of a goal being verified, LONG_MAX: none.
+  std::vector<long> caps, goals;
   explicit PortfolioState(std::size_t n) : caps(n, LONG_MAX), goals(n, LONG_MAX) {}
   // Member j's bound from member i's count n: an earlier member wins a tie.
   static long bound(std::size_t j, std::size_t i, long n) { return n == LONG_MAX ? LONG_MAX : j < i ? n : n - 1; }
-  // Another member than j verifies a goal j, at `nodes`, cannot beat (under lock).
-  bool beaten(std::size_t j, long nodes) const;
+  // Another member than j verifies a goal j, at `calls`, cannot beat (under lock).
+  bool beaten(std::size_t j, long calls) const;
 };
 
 long ContactPlanner::MemberLink::cap() const {
@@ -61,28 +63,28 @@ long ContactPlanner::MemberLink::cap() const {
   return state->caps[index];
 }
 
-void ContactPlanner::MemberLink::verifying(long nodes) {
+void ContactPlanner::MemberLink::verifying(long calls) {
   {
     std::lock_guard<std::mutex> hold(state->lock);
-    state->goals[index] = nodes < 0 ? LONG_MAX : nodes;
+    state->goals[index] = calls < 0 ? LONG_MAX : calls;
   }
   state->changed.notify_all();
 }
 
-bool PortfolioState::beaten(std::size_t j, long nodes) const {
+bool PortfolioState::beaten(std::size_t j, long calls) const {
   for (std::size_t i = 0; i < goals.size(); ++i)
-    if (i != j && nodes > bound(j, i, goals[i])) return true;
+    if (i != j && calls > bound(j, i, goals[i])) return true;
   return false;
 }
 
-bool ContactPlanner::MemberLink::beaten(long nodes) const {
+bool ContactPlanner::MemberLink::beaten(long calls) const {
   std::lock_guard<std::mutex> hold(state->lock);
-  return state->beaten(index, nodes);
+  return state->beaten(index, calls);
 }
 
-void ContactPlanner::MemberLink::gate(long nodes, const std::function<bool()>& give_up) {
+void ContactPlanner::MemberLink::gate(long calls, const std::function<bool()>& give_up) {
   std::unique_lock<std::mutex> hold(state->lock);
-  while (state->beaten(index, nodes) && nodes <= state->caps[index]) {
+  while (state->beaten(index, calls) && calls <= state->caps[index]) {
     state->changed.wait_for(hold, std::chrono::milliseconds(50));
     if (give_up()) return;
   }
@@ -148,7 +150,7 @@ PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, 
       std::lock_guard<std::mutex> hold(state.lock);
       if (r.solved())
         for (std::size_t j = 0; j < n; ++j)
-          if (j != i) state.caps[j] = std::min(state.caps[j], PortfolioState::bound(j, i, r.stats.nodes_generated));
+          if (j != i) state.caps[j] = std::min(state.caps[j], PortfolioState::bound(j, i, r.stats.searchCalls()));
       state.goals[i] = LONG_MAX;
       ++done;
     }
@@ -172,7 +174,7 @@ PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, 
   int winner = -1;
   for (std::size_t i = 0; i < n; ++i)
     if (results[i].solved() &&
-        (winner < 0 || results[i].stats.nodes_generated < results[winner].stats.nodes_generated))
+        (winner < 0 || results[i].stats.searchCalls() < results[winner].stats.searchCalls()))
       winner = static_cast<int>(i);
   std::vector<PlanningResult::Member> outcomes;
   for (std::size_t i = 0; i < n; ++i)

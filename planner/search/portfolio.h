@@ -1,23 +1,32 @@
 #pragma once
 // The contact planner's portfolio (PlannerParameters::portfolio): one search
 // per member, each on its own thread, and the plan of the member that solved
-// in the fewest nodes. Private to the planner (contact_planner.cpp).
+// in the fewest posture calls. Private to the planner (contact_planner.cpp).
 //
-// Why the winner does not depend on timing: a member i that solves with n_i
-// nodes lowers every other member j's cap to n_i (j listed before i, which
-// wins a tie) or n_i - 1 (j after). Up to its cap each member makes exactly
+// Why posture calls and not nodes: calls are most of a search's time, and
+// members differ in calls per node. On chair_paper's OMPL guide the
+// quality-function member spends 44 s of CPU to pass the winner's 572 nodes
+// but 32 s to pass its 1,270 calls; counted in nodes, the portfolio waited
+// for the slower member (docs/design.md section 7). A member's count is
+// that of its search made one call at a time (calls a batch solved ahead of
+// their turn are left out until it comes), so it does not depend on threads.
+//
+// Why the winner does not depend on timing: a member i that solves with c_i
+// calls lowers every other member j's cap to c_i (j listed before i, which
+// wins a tie) or c_i - 1 (j after). Up to its cap each member makes exactly
 // the search it makes alone, and its count only grows: a member stopped
-// past its cap would have solved, alone, in more nodes than i did, so it
+// past its cap would have solved, alone, in more calls than i did, so it
 // cannot have been the winner; the winner is never stopped (its count
 // never passes a cap set by a worse member).
 //
 // While member i verifies the transitions of a goal found at count g_i, a
-// member j whose count is already past that (tie-adjusted) waits at the top
-// of its loop: if i's plan is accepted j is outrun, if refused j goes on as
-// if it had not waited. Its core goes to i's verifier meanwhile. If j was
-// itself verifying a goal, it stops that verification and verifies again
-// after i's verdict (the transitions it solved are remembered by its
-// verifier), so that only the better goal's verification runs.
+// member j whose count is already past that (tie-adjusted) waits, at the
+// top of its loop or within an expansion: if i's plan is accepted j is
+// outrun, if refused j goes on as if it had not waited. Its core goes to
+// i's verifier meanwhile. If j was itself verifying a goal, it stops that
+// verification and verifies again after i's verdict (the transitions it
+// solved are remembered by its verifier), so that only the better goal's
+// verification runs.
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -34,16 +43,16 @@ struct PortfolioState;
 struct ContactPlanner::MemberLink {
   PortfolioState* state = nullptr;
   std::size_t index = 0;  // this member's
-  long cap() const;       // the count past which this member cannot win
-  bool outrun(long nodes) const { return nodes > cap(); }
+  long cap() const;       // the count of posture calls past which this member cannot win
+  bool outrun(long calls) const { return calls > cap(); }
   // A goal found at this count is being verified (-1: no longer).
-  void verifying(long nodes);
-  // Another member verifies a goal found at a count this one, at `nodes`,
+  void verifying(long calls);
+  // Another member verifies a goal found at a count this one, at `calls`,
   // cannot beat.
-  bool beaten(long nodes) const;
+  bool beaten(long calls) const;
   // Waits while another member verifies a goal found at a count this one,
-  // at `nodes`, cannot beat; `give_up` (polled) ends the wait early.
-  void gate(long nodes, const std::function<bool()>& give_up);
+  // at `calls`, cannot beat; `give_up` (polled) ends the wait early.
+  void gate(long calls, const std::function<bool()>& give_up);
 };
 
 struct ContactPlanner::Portfolio {
