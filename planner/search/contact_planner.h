@@ -137,10 +137,9 @@ struct PlannerParameters {
   // parameters with the variant applied and threads / members posture
   // generators, and returns the plan of the member that solved in the
   // fewest posture calls (PlanningStats::searchCalls; ties: the earlier
-  // member). A member stops as soon as it has made more calls than a member
-  // that solved, so the
-  // winner does not depend on the members' speeds: the same plan as that
-  // member run alone, whatever the timing. The counts of a search hinge on
+  // member). A member stops as soon as it has made more calls than a
+  // member that solved, so the winner does not depend on the members'
+  // speeds: the same plan as that member run alone, whatever the timing. The counts of a search hinge on
   // the last bits of its witnesses (bench_sensitivity); members that differ
   // in them fail on different perturbations.
   std::vector<PlannerVariant> portfolio;

@@ -6,10 +6,12 @@
 // Why posture calls and not nodes: calls are most of a search's time, and
 // members differ in calls per node. On chair_paper's OMPL guide the
 // quality-function member spends 44 s of CPU to pass the winner's 572 nodes
-// but 32 s to pass its 1,270 calls; counted in nodes, the portfolio waited
-// for the slower member (docs/design.md section 7). A member's count is
-// that of its search made one call at a time (calls a batch solved ahead of
-// their turn are left out until it comes), so it does not depend on threads.
+// but about 32 s to pass its 1,255 calls; counted in nodes, the portfolio
+// waited for the slower member (docs/design.md section 7). A member's count
+// is that of its search made one call at a time (PlanningStats::searchCalls:
+// calls a batch solved ahead of their turn are left out until it comes, so
+// it does not depend on threads; calls exporting a goal's plan not at all,
+// so that it stays the count announced while that goal is verified).
 //
 // Why the winner does not depend on timing: a member i that solves with c_i
 // calls lowers every other member j's cap to c_i (j listed before i, which
