@@ -197,8 +197,9 @@ TEST(Portfolio, TheFirstOfTwoEqualMembersWinsThoughSlower) {
   ASSERT_TRUE(r.solved()) << r.reason;
   EXPECT_EQ(r.winner, 0) << r.members[0].reason;
   // The second, not slowed, normally solves first (then with the same count).
-  if (r.members[1].status == PlanningResult::Status::Solved)
+  if (r.members[1].status == PlanningResult::Status::Solved) {
     EXPECT_EQ(r.members[0].stats.searchCalls(), r.members[1].stats.searchCalls());
+  }
 }
 
 TEST(Portfolio, OfTwoEqualMembersTheFirstWins) {
