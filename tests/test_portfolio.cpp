@@ -59,9 +59,10 @@ void slowDown(PlannerParameters& q) {
 }  // namespace
 
 // Each member has two posture generators here, so that calls are solved
-// ahead of their turn (lazy sons' batches): a member is compared by the
-// calls of its search made one at a time, never by a batch's calls solved
-// ahead, which would stop a member that alone solves in fewer calls.
+// ahead of their turn (lazy sons' batches) and the comparison runs with
+// them; that they count only in their turn is what
+// TheFirstOfTwoEqualMembersWinsThoughSlower tests (step_forward's goal
+// expansions take every call they solve).
 TEST(Portfolio, TheMemberWithTheFewestPostureCallsWinsWithThePlanItMakesAlone) {
   const Scenario& sc = step();
   PlannerParameters a, b;
