@@ -113,12 +113,12 @@ TEST(AcyclicPlanner, APortfolioWritesItsWinnersPlanAndSaysEachMembersOutcome) {
   const bool fine_won = r.output.find("\"fine\" (its plan)") != std::string::npos;
   // Each member's count of posture calls, which they are compared by: the
   // winner's the fewest, unless the other was outrun.
-  auto callsOf = [&](const std::string& name) {
-    const std::size_t line = r.output.find("portfolio member " + std::string(name == "fine" ? "1" : "2"));
+  auto callsOf = [&](int member) {  // 1: fine, 2: coarse
+    const std::size_t line = r.output.find("portfolio member " + std::to_string(member));
     const std::size_t at = r.output.find(" nodes generated, ", line);
     return at == std::string::npos ? -1L : std::stol(r.output.substr(at + 18));
   };
-  const long winner_calls = callsOf(fine_won ? "fine" : "coarse"), other_calls = callsOf(fine_won ? "coarse" : "fine");
+  const long winner_calls = callsOf(fine_won ? 1 : 2), other_calls = callsOf(fine_won ? 2 : 1);
   ASSERT_GT(winner_calls, 0) << r.output;
   EXPECT_GE(other_calls, winner_calls) << r.output;
   // The verification's summary is the winner's, and says so.
