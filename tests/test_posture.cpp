@@ -847,6 +847,128 @@ TEST(QuasiStaticCheck, VerdictsWithoutTheMarginLpAgreeWithFullChecks) {
   EXPECT_GT(torque_bound, 0);
 }
 
+// With the forces reused (setForcesReused, as the interpolator checks its
+// samples), the verdicts are those of LP 2 alone, along small moves between
+// the chair plan's stances with single supports mixed in; most of those
+// checks are decided without an LP, and each such decision's forces balance
+// the robot, lie in their pyramids and bound LP 2's optimum from above.
+TEST(QuasiStaticCheck, ReusedForcesGiveTheLpsVerdicts) {
+  const Scenario& sc = chair();
+  const RobotModel& m = *sc.robot;
+  QuasiStaticChecker reusing(sc.robot, sc.scene), lp(sc.robot, sc.scene);
+  for (QuasiStaticChecker* c : {&reusing, &lp}) c->setWarmStart(true), c->setMarginComputed(false);
+  reusing.setForcesReused(true);
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
+  Kinematics k(sc.robot);
+  int checks = 0, infeasible = 0;
+  auto check = [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
+    k.setConfiguration(q);
+    const long before = reusing.forcesReused();
+    const QuasiStaticReport a = reusing.check(k, stance);
+    const QuasiStaticReport b = lp.check(k, stance);
+    ++checks;
+    infeasible += !b.feasible;
+    ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
+    EXPECT_EQ(a.reason, b.reason) << checks;
+    if (reusing.forcesReused() == before) return;
+    // Decided by reused forces: a point LP 2 accepts, its ratio above LP 2's optimum.
+    EXPECT_LE(a.residual, 1e-9) << checks;
+    EXPECT_LE(a.worst_cone_ratio, 1 + 1e-9) << checks;
+    EXPECT_LE(a.worst_torque_ratio, 1.0) << checks;
+    EXPECT_GE(a.worst_torque_ratio, b.worst_torque_ratio - 1e-6) << checks;
+    Eigen::VectorXd tau = k.gravityTorques();  // through Simbody's station Jacobians, not the checker's
+    for (std::size_t c = 0; c < stance.size(); ++c) {
+      const int link = m.spots()[stance[c].spot].link;
+      for (std::size_t i = 0; i < a.points[c].size(); ++i)
+        tau -= k.pointJacobian(link, k.linkPose(link).inverse() * a.points[c][i]).transpose() * a.forces[c][i];
+    }
+    EXPECT_LE(tau.head<6>().norm(), 1e-6 * m.totalMass() * 9.81) << checks;
+    for (const auto& j : m.joints()) EXPECT_LE(std::abs(tau[6 + j.index]), j.effort) << checks << " " << j.name;
+  };
+  for (std::size_t i = 0; i + 1 < plan.stances.size(); i += 3) {
+    const auto stance = plan.stances[i].specs();
+    const Configuration& q0 = plan.stances[i].configuration;
+    const Configuration& q1 = plan.stances[i + 1].configuration;
+    for (int n = 0; n <= 10; ++n) {
+      const double t = 0.01 * n;
+      Configuration q = q0;
+      q.base_position = (1 - t) * q0.base_position + t * q1.base_position;
+      q.joints = (1 - t) * q0.joints + t * q1.joints;
+      check(q, stance);
+      if (n == 5) {  // a single support in between: the same posture on the stance's first supporting contact
+        auto one = stance;
+        bool first = true;
+        for (auto& c : one)
+          if (c.supporting) c.supporting = first, first = false;
+        check(q, one);
+      }
+    }
+  }
+  EXPECT_GT(checks, 300);
+  EXPECT_GT(infeasible, 5);
+  EXPECT_GT(reusing.forcesReused(), checks / 2);
+}
+
+// Reused forces are tried against the torque limits, and a point beyond one
+// decides nothing (LP 2 does): on a robot whose right knee holds 10 N m and
+// right shoulder 5 N m, standing on both feet, the chest pitched and each
+// leg's hip and ankle rolled a little at a time, LP 2 keeps the knee within
+// its limit where the previous check's forces, rebalanced, would not (a
+// verdict "infeasible" from those forces alone would be wrong 39 times in
+// these 123 checks); and the right arm raised forward takes its shoulder
+// beyond its limit whatever the forces, which both refuse.
+TEST(QuasiStaticCheck, ReusedForcesRespectTorqueLimits) {
+  const Scenario& sc = chair();
+  test::TempDir dir;
+  std::string urdf = test::readFile(test::sourcePath("models/hrp2/hrp2.urdf"));
+  for (const auto& [joint, effort] : {std::pair{"RLEG_JOINT3", "10"}, std::pair{"RARM_JOINT0", "5"}}) {
+    const std::regex limit(std::string("(<joint name=\"") + joint + "\"[\\s\\S]*?effort=\")[0-9.]+(\")");
+    const std::string was = urdf;
+    urdf = std::regex_replace(urdf, limit, std::string("$01") + effort + "$2", std::regex_constants::format_first_only);
+    ASSERT_NE(urdf, was) << joint;
+  }
+  dir.write("hrp2.urdf", urdf);
+  dir.write("hrp2.yaml", test::readFile(test::sourcePath("models/hrp2/hrp2.yaml")));
+  auto weak = RobotModel::load(dir.path() + "/hrp2.yaml");
+  QuasiStaticChecker reusing(weak, sc.scene), lp(weak, sc.scene);
+  for (QuasiStaticChecker* c : {&reusing, &lp}) c->setWarmStart(true), c->setMarginComputed(false);
+  reusing.setForcesReused(true);
+  Configuration q = weak->posture("half_sitting");
+  q.base_position.x() = -0.6;
+  q.base_position.y() = -0.8;
+  const std::vector<ContactSpec> feet = {contactOf(sc, "r_sole", "floor", true, q),
+                                         contactOf(sc, "l_sole", "floor", true, q)};
+  Kinematics k(weak);
+  int checks = 0, refused = 0;
+  auto check = [&](const Configuration& at) {
+    k.setConfiguration(at);
+    const QuasiStaticReport a = reusing.check(k, feet);
+    const QuasiStaticReport b = lp.check(k, feet);
+    ++checks;
+    refused += !b.feasible;
+    ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
+    EXPECT_EQ(a.reason, b.reason) << checks;
+  };
+  auto joint = [&](const char* name) { return weak->jointIndex(name); };
+  for (const auto& [moved, against] : {std::pair{"CHEST_JOINT1", ""}, std::pair{"RLEG_JOINT1", "RLEG_JOINT5"},
+                                       std::pair{"LLEG_JOINT1", "LLEG_JOINT5"}})
+    for (int i = -20; i <= 20; ++i) {  // 0.01 rad a check
+      Configuration at = q;
+      at.joints[joint(moved)] += 0.01 * i;
+      if (*against) at.joints[joint(against)] -= 0.01 * i;
+      check(at);
+    }
+  const long standing_reused = reusing.forcesReused();
+  EXPECT_EQ(refused, 0);
+  for (int n = 0; n <= 18; ++n) {  // the right arm from hanging to raised forward, 5 degrees a check
+    Configuration at = q;
+    at.joints[joint("RARM_JOINT0")] = -n * 5 * M_PI / 180;
+    check(at);
+  }
+  EXPECT_GT(standing_reused, 80);  // of the 123 standing checks
+  EXPECT_GT(refused, 3);           // the arm raised
+}
+
 // The checker takes each corner's Jacobian from one frame Jacobian of its
 // contact (J_p = J_v - [p - o]x J_w): the forces it reports, mapped through
 // Simbody's own station Jacobian at each reported corner, balance gravity on

@@ -190,20 +190,76 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     return extra;
   };
 
-  // LP 2 first: forces in their pyramids that balance gravity, with the
-  // smallest worst torque ratio; infeasible only when no forces balance at all.
   std::unique_lock<std::mutex> warm_lock(warm_mutex_, std::defer_lock);
   if (warm_start_) warm_lock.try_lock();
   WarmStart* warm2 = warm_lock.owns_lock() ? &warm_[1] : nullptr;
   WarmStart* warm1 = warm_lock.owns_lock() ? &warm_[0] : nullptr;
-  Lp lp2;
-  const int t_col = build(lp2, false);
-  std::vector<double> x2;
-  if (!lp2.solve(x2, warm2)) {
-    rep.reason = "no contact forces inside the friction pyramids balance gravity (the centre of mass is outside the support)";
-    return rep;
+  const int nf = 3 * static_cast<int>(corners.size());
+  std::vector<double> x2;  // forces per corner (f_n, f_t1, f_t2), then LP 2's t when it is solved
+
+  // Forces reused (setForcesReused): a point that proves LP 2 feasible. The
+  // seed moved by the least-norm change that balances the base here, then
+  // accepted when inside every facet with its normal force >= 0, every torque
+  // within (1 - 1e-6) of its limit and the balance exact to 1e-9 of the
+  // weight: LP 2's optimum is then at most that point's ratio, below 1.
+  auto certify = [&](const Eigen::VectorXd& seed, std::vector<double>& x) {
+    Eigen::MatrixXd M(nt, nf);  // generalized forces of each corner's (f_n, f_t1, f_t2)
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+      const Corner& c = corners[k];
+      M.col(3 * k) = c.JT * c.n;
+      M.col(3 * k + 1) = c.JT * c.t1;
+      M.col(3 * k + 2) = c.JT * c.t2;
+    }
+    const auto A = M.topRows<6>();
+    const Eigen::Matrix<double, 6, 6> AAt = A * A.transpose();
+    const Eigen::VectorXd f = seed + A.transpose() * AAt.ldlt().solve(g.head<6>() - A * seed);
+    const Eigen::VectorXd tau = g - M * f;
+    if (!(tau.head<6>().norm() <= 1e-3 * residualTolerance() * W)) return false;
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+      if (!(f[3 * k] >= 0)) return false;
+      for (const Facet& fa : kFacets)
+        if (!(corners[k].mu * fa.inset * f[3 * k] - fa.cos * f[3 * k + 1] - fa.sin * f[3 * k + 2] >= 0)) return false;
+    }
+    for (const auto& j : m.joints())
+      if (!(std::abs(tau[6 + j.index]) <= (1 - 1e-6) * j.effort)) return false;
+    x.assign(f.data(), f.data() + nf);
+    return true;
+  };
+  // The seed: the previous check's point, when it had the same supporting
+  // contacts. LP 2's own solution would not do: at its vertex unloaded
+  // corners and some facets sit exactly on their bounds (and LP 1's on a
+  // torque limit), and the next sample's change leaves them. The midpoint of
+  // the two is inside both by half their margins.
+  const bool may_reuse = reuse_forces_ && !margin_computed_ && warm_lock.owns_lock();
+  std::vector<std::pair<int, int>> supporting;  // (spot, surface), in stance order
+  if (may_reuse)
+    for (const auto& c : stance)
+      if (c.supporting) supporting.push_back({c.spot, c.surface});
+  const bool certified =
+      may_reuse && last_.contacts == supporting && last_.f.size() == nf && certify(last_.f, x2);
+  if (certified) {
+    ++reused_;
+    last_.f = Eigen::Map<const Eigen::VectorXd>(x2.data(), nf);
+  } else {
+    // LP 2: forces in their pyramids that balance gravity, with the smallest
+    // worst torque ratio; infeasible only when no forces balance at all.
+    Lp lp2;
+    const int t_col = build(lp2, false);
+    if (!lp2.solve(x2, warm2)) {
+      rep.reason = "no contact forces inside the friction pyramids balance gravity (the centre of mass is outside the support)";
+      return rep;
+    }
+    rep.worst_torque_ratio = x2[t_col];
+    if (may_reuse) last_.contacts.clear();
+    if (may_reuse && x2[t_col] < 1) {
+      Lp lp1;
+      const int s_col = build(lp1, true);
+      std::vector<double> x1;
+      if (lp1.solve(x1, warm1) && x1[s_col] > 0)
+        last_ = {supporting, 0.5 * (Eigen::Map<const Eigen::VectorXd>(x1.data(), nf) +
+                                    Eigen::Map<const Eigen::VectorXd>(x2.data(), nf))};
+    }
   }
-  rep.worst_torque_ratio = x2[t_col];
   // LP 1: how far inside the pyramids the forces can stay, torques within limits.
   if (margin_computed_) {
     Lp lp1;
@@ -212,7 +268,7 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     rep.margin = lp1.solve(x1, warm1) ? x1[s_col] : -std::numeric_limits<double>::infinity();
   }
 
-  // Forces, torques and the balance residual at LP 2's solution.
+  // Forces, torques and the balance residual at LP 2's solution (or the certified point).
   Eigen::VectorXd JTf = Eigen::VectorXd::Zero(nt);
   rep.points.assign(stance.size(), {});
   rep.forces.assign(stance.size(), {});
@@ -231,6 +287,7 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     const double r = std::abs(tau[6 + j.index]) / j.effort;
     if (r > worst) worst = r, rep.worst_joint = j.name;
   }
+  if (certified) rep.worst_torque_ratio = worst;  // that point's: LP 2's optimum is at most this
   const bool margin_ok = !margin_computed_ || rep.margin >= -1e-9;  // implied by worst <= 1 (setMarginComputed)
   rep.feasible = worst <= 1 + 1e-9 && margin_ok && rep.residual <= residualTolerance();
   if (!rep.feasible) {

@@ -12,6 +12,7 @@
 // LP 2: the smallest worst torque ratio max_j |tau_j| / limit_j, forces in
 //       their pyramids, balance exact.
 // tau = g(q) - sum J^T f (holding torques, kinematics.h).
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,9 +64,34 @@ class QuasiStaticChecker {
   // verdict, thousands of times (a trajectory's samples): half the LPs.
   void setMarginComputed(bool on) { margin_computed_ = on; }
 
+  // Off by default; only with setWarmStart(true) and setMarginComputed(false)
+  // (a caller that wants verdicts, one sample after the other). On, a check
+  // first tries the forces of the previous check with the same supporting
+  // contacts, moved by the least-norm change that restores the base's
+  // balance at this posture: when they stay inside every pyramid facet and
+  // keep every torque within (1 - 1e-6) of its limit, forces exist and LP 2
+  // is not solved. The verdict is the same (LP 2's optimum is at most that
+  // point's torque ratio, below 1); the report's torque ratio is that
+  // point's, an upper bound of LP 2's optimum, and its forces are that
+  // point's. Otherwise LP 2 is solved as without it and decides; the next
+  // check's point is then the midpoint of LP 2's and LP 1's forces, inside
+  // both the facets and the limits (each LP's own vertex has corners and
+  // facets, or a torque, exactly at their bounds, which the next sample's
+  // change leaves). Along an interpolated piece most samples are a small move
+  // from the last: the interpolator's checks skip most of their LPs.
+  void setForcesReused(bool on) { reuse_forces_ = on; }
+  long forcesReused() const { return reused_; }  // checks decided without an LP, since construction
+
   struct WarmStart {
     int rows = -1, cols = -1;
     std::vector<unsigned char> status;
+  };
+  // The next check's point (setForcesReused): corner forces (f_n, f_t1,
+  // f_t2 per corner) for these supporting contacts (spot, surface), in
+  // stance order; none after a check that could not give one.
+  struct LastForces {
+    std::vector<std::pair<int, int>> contacts;
+    Eigen::VectorXd f;
   };
 
  private:
@@ -74,8 +100,11 @@ class QuasiStaticChecker {
   // Guarded: a checker shared by threads solves cold when another holds it.
   bool warm_start_ = false;
   bool margin_computed_ = true;
+  bool reuse_forces_ = false;
   mutable std::mutex warm_mutex_;
   mutable WarmStart warm_[2];
+  mutable LastForces last_;  // guarded by warm_mutex_, as warm_
+  mutable std::atomic<long> reused_{0};
 };
 
 }  // namespace acyclic

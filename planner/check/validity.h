@@ -71,6 +71,12 @@ class ValidityChecker {
     setWarmStart(true);
     setMarginComputed(false);
   }
+  // After checkVerdictsInSequence: the last feasible check's forces tried
+  // first (QuasiStaticChecker::setForcesReused): the same verdicts, most
+  // equilibrium LPs skipped, the forces reported no longer LP 2's. For the
+  // interpolator, which reads verdicts only; acyclic-check reports the LP's.
+  void setForcesReused(bool on) { statics_.setForcesReused(on); }
+  long forcesReused() const { return statics_.forcesReused(); }
 
  private:
   std::shared_ptr<const RobotModel> robot_;
