@@ -7,6 +7,7 @@ namespace acyclic::hrp2 {
 CheckResult checkContract(const Trajectory& tr, const Scenario& sc, const std::function<void(int, int)>& progress) {
   ValidityChecker checker(sc.robot, sc.scene);
   checker.checkVerdictsInSequence();  // verdicts only, sample after sample (planner/check/validity.h)
+  checker.setForcesReused(true);      // and most of their equilibrium LPs skipped (the same verdicts)
   TrajectoryCheckOptions opt;
   opt.max_violations = 1;
   const TrajectoryReport rep = acyclic::checkTrajectory(tr, sc, checker, opt, progress);
