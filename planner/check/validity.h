@@ -71,10 +71,11 @@ class ValidityChecker {
     setWarmStart(true);
     setMarginComputed(false);
   }
-  // After checkVerdictsInSequence: the last feasible check's forces tried
+  // After checkVerdictsInSequence: the previous check's forces tried
   // first (QuasiStaticChecker::setForcesReused): the same verdicts, most
   // equilibrium LPs skipped, the forces reported no longer LP 2's. For the
-  // interpolator, which reads verdicts only; acyclic-check reports the LP's.
+  // interpolator and the bridge's contract check, which read verdicts only;
+  // acyclic-check reports the LP's forces.
   void setForcesReused(bool on) { statics_.setForcesReused(on); }
   long forcesReused() const { return statics_.forcesReused(); }
 
