@@ -158,7 +158,7 @@ TransitionSolver::TransitionSolver(const Scenario& sc, TransitionOptions options
     wide_generator_.emplace(sc.robot, sc.scene, wide);
   }
   // Thousands of checks in sequence, for their verdict only: pairs that
-  // cannot be within 2 cm are not measured, the equilibrium LPs start from
+  // cannot be within 1 mm are not measured, the equilibrium LPs start from
   // the previous check's basis, and the previous check's forces, rebalanced,
   // decide most samples without an LP (validity.h).
   checker_.checkVerdictsInSequence();

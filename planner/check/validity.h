@@ -55,7 +55,7 @@ class ValidityChecker {
   // and are not measured: the verdict is the same, the summary's smallest
   // clearance is then over the pairs measured. Infinite by default (every
   // pair measured, as acyclic-check reports); a caller that checks thousands
-  // of postures for their verdict (the interpolator) sets a few centimetres.
+  // of postures for their verdict (the interpolator) sets a millimetre.
   void setClearanceCutoff(double m) { clearance_cutoff_ = m; }
   // The equilibrium LPs warm-started (QuasiStaticChecker::setWarmStart): same
   // verdicts, faster along a trajectory.
@@ -64,10 +64,13 @@ class ValidityChecker {
   // same verdicts, the summary's margin "not computed".
   void setMarginComputed(bool on) { statics_.setMarginComputed(on); }
   // All three, as every caller that checks the samples of a trajectory one
-  // after the other for their verdicts uses them: a 2 cm cutoff, warm LPs,
-  // no margin LP.
+  // after the other for their verdicts uses them: a 1 mm cutoff, warm LPs,
+  // no margin LP. The cutoff: a pair's bounding spheres over 1 mm apart put
+  // its shapes over 1 mm apart, where FCL's distance (exact to far below a
+  // micrometre) cannot report a penetration; 2 cm before, measuring pairs
+  // that could not fail (a transition of chair_paper 7% faster at 1 mm).
   void checkVerdictsInSequence() {
-    setClearanceCutoff(0.02);
+    setClearanceCutoff(0.001);
     setWarmStart(true);
     setMarginComputed(false);
   }
