@@ -969,6 +969,40 @@ TEST(QuasiStaticCheck, ReusedForcesRespectTorqueLimits) {
   EXPECT_GT(refused, 3);           // the arm raised
 }
 
+// Checked for their verdicts in sequence (checkVerdictsInSequence: pairs
+// whose bounding spheres are over 1 mm apart left unmeasured), postures find
+// the same collisions, with the same depths, as when every pair is
+// measured: the chair plan's stances with each arm swept down through the
+// table and the thighs, and the chest bent onto the table.
+TEST(ValidityCheck, VerdictsInSequenceFindEveryCollision) {
+  const Scenario& sc = chair();
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
+  ValidityChecker sequence(sc.robot, sc.scene), full(sc.robot, sc.scene);
+  sequence.checkVerdictsInSequence();
+  auto collisions = [](const ValidityReport& r) {
+    for (const auto& p : r.parts)
+      if (p.name == "collisions") return p;
+    ADD_FAILURE() << "no collisions part";
+    return CheckPart{};
+  };
+  int checks = 0, colliding = 0;
+  for (std::size_t i = 0; i < plan.stances.size(); i += 4) {
+    const auto stance = plan.stances[i].specs();
+    for (const char* joint : {"RARM_JOINT0", "LARM_JOINT0", "CHEST_JOINT1"})
+      for (int n = 0; n <= 24; ++n) {
+        Configuration q = plan.stances[i].configuration;
+        q.joints[sc.robot->jointIndex(joint)] += (joint[0] == 'C' ? 0.03 : -0.08) * n;
+        const CheckPart a = collisions(sequence.checkPosture(q, stance));
+        const CheckPart b = collisions(full.checkPosture(q, stance));
+        ++checks;
+        colliding += !b.ok();
+        ASSERT_EQ(a.violations, b.violations) << i << " " << joint << " " << n;
+      }
+  }
+  EXPECT_GT(checks, 500);
+  EXPECT_GT(colliding, checks / 10);
+}
+
 // The checker takes each corner's Jacobian from one frame Jacobian of its
 // contact (J_p = J_v - [p - o]x J_w): the forces it reports, mapped through
 // Simbody's own station Jacobian at each reported corner, balance gravity on
