@@ -847,6 +847,28 @@ TEST(QuasiStaticCheck, VerdictsWithoutTheMarginLpAgreeWithFullChecks) {
   EXPECT_GT(torque_bound, 0);
 }
 
+namespace {
+// Two checkers of verdicts in sequence (warm LPs, no margin LP) on the same
+// robot, one reusing forces (setForcesReused): each check goes to both.
+struct ReusingAndLp {
+  QuasiStaticChecker reusing, lp;
+  ReusingAndLp(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
+      : reusing(robot, scene), lp(robot, scene) {
+    for (QuasiStaticChecker* c : {&reusing, &lp}) c->setWarmStart(true), c->setMarginComputed(false);
+    reusing.setForcesReused(true);
+  }
+  struct Reports {
+    QuasiStaticReport reusing, lp;
+    bool reused;  // the reusing checker decided without an LP
+  };
+  Reports check(const Kinematics& k, const std::vector<ContactSpec>& stance) {
+    const long before = reusing.forcesReused();
+    QuasiStaticReport a = reusing.check(k, stance);
+    return {std::move(a), lp.check(k, stance), reusing.forcesReused() > before};
+  }
+};
+}  // namespace
+
 // With the forces reused (setForcesReused, as the interpolator checks its
 // samples), the verdicts are those of LP 2 alone, along small moves between
 // the chair plan's stances with single supports mixed in; most of those
@@ -855,22 +877,18 @@ TEST(QuasiStaticCheck, VerdictsWithoutTheMarginLpAgreeWithFullChecks) {
 TEST(QuasiStaticCheck, ReusedForcesGiveTheLpsVerdicts) {
   const Scenario& sc = chair();
   const RobotModel& m = *sc.robot;
-  QuasiStaticChecker reusing(sc.robot, sc.scene), lp(sc.robot, sc.scene);
-  for (QuasiStaticChecker* c : {&reusing, &lp}) c->setWarmStart(true), c->setMarginComputed(false);
-  reusing.setForcesReused(true);
+  ReusingAndLp both(sc.robot, sc.scene);
   const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
   Kinematics k(sc.robot);
   int checks = 0, infeasible = 0;
   auto check = [&](const Configuration& q, const std::vector<ContactSpec>& stance) {
     k.setConfiguration(q);
-    const long before = reusing.forcesReused();
-    const QuasiStaticReport a = reusing.check(k, stance);
-    const QuasiStaticReport b = lp.check(k, stance);
+    const auto [a, b, reused] = both.check(k, stance);
     ++checks;
     infeasible += !b.feasible;
     ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
     EXPECT_EQ(a.reason, b.reason) << checks;
-    if (reusing.forcesReused() == before) return;
+    if (!reused) return;
     // Decided by reused forces: a point LP 2 accepts, its ratio above LP 2's optimum.
     EXPECT_LE(a.residual, 1e-9) << checks;
     EXPECT_LE(a.worst_cone_ratio, 1 + 1e-9) << checks;
@@ -906,7 +924,7 @@ TEST(QuasiStaticCheck, ReusedForcesGiveTheLpsVerdicts) {
   }
   EXPECT_GT(checks, 300);
   EXPECT_GT(infeasible, 5);
-  EXPECT_GT(reusing.forcesReused(), checks / 2);
+  EXPECT_GT(both.reusing.forcesReused(), checks / 2);
 }
 
 // Reused forces are tried against the torque limits, and a point beyond one
@@ -930,9 +948,7 @@ TEST(QuasiStaticCheck, ReusedForcesRespectTorqueLimits) {
   dir.write("hrp2.urdf", urdf);
   dir.write("hrp2.yaml", test::readFile(test::sourcePath("models/hrp2/hrp2.yaml")));
   auto weak = RobotModel::load(dir.path() + "/hrp2.yaml");
-  QuasiStaticChecker reusing(weak, sc.scene), lp(weak, sc.scene);
-  for (QuasiStaticChecker* c : {&reusing, &lp}) c->setWarmStart(true), c->setMarginComputed(false);
-  reusing.setForcesReused(true);
+  ReusingAndLp both(weak, sc.scene);
   Configuration q = weak->posture("half_sitting");
   q.base_position.x() = -0.6;
   q.base_position.y() = -0.8;
@@ -942,8 +958,7 @@ TEST(QuasiStaticCheck, ReusedForcesRespectTorqueLimits) {
   int checks = 0, refused = 0;
   auto check = [&](const Configuration& at) {
     k.setConfiguration(at);
-    const QuasiStaticReport a = reusing.check(k, feet);
-    const QuasiStaticReport b = lp.check(k, feet);
+    const auto [a, b, reused] = both.check(k, feet);
     ++checks;
     refused += !b.feasible;
     ASSERT_EQ(a.feasible, b.feasible) << checks << ": " << a.reason << " | " << b.reason;
@@ -958,7 +973,7 @@ TEST(QuasiStaticCheck, ReusedForcesRespectTorqueLimits) {
       if (*against) at.joints[joint(against)] -= 0.01 * i;
       check(at);
     }
-  const long standing_reused = reusing.forcesReused();
+  const long standing_reused = both.reusing.forcesReused();
   EXPECT_EQ(refused, 0);
   for (int n = 0; n <= 18; ++n) {  // the right arm from hanging to raised forward, 5 degrees a check
     Configuration at = q;
