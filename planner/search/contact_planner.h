@@ -139,9 +139,10 @@ struct PlannerParameters {
   // fewest posture calls (PlanningStats::searchCalls; ties: the earlier
   // member). A member stops as soon as it has made more calls than a
   // member that solved, so the winner does not depend on the members'
-  // speeds: the same plan as that member run alone, whatever the timing. The counts of a search hinge on
-  // the last bits of its witnesses (bench_sensitivity); members that differ
-  // in them fail on different perturbations.
+  // speeds: the same plan as that member run alone, whatever the timing.
+  // The counts of a search hinge on the last bits of its witnesses
+  // (bench_sensitivity); members that differ in them fail on different
+  // perturbations.
   std::vector<PlannerVariant> portfolio;
   PlannerParameters();
 };
