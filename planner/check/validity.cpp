@@ -137,14 +137,19 @@ CheckPart ValidityChecker::checkCollisions(const std::vector<ContactSpec>& stanc
     if (allowed) {
       ++n_touch;
       worst_pen = std::max(worst_pen, -d.distance);
-      if (d.distance < -tol_.penetration)
+      if (d.distance < -tol_.penetration) {
         p.violations.push_back(collision_.describe(d.pair) +
                                fmt(": contacting body penetrates its surface's obstacle by %.2f mm", -d.distance * 1e3));
+        p.links.push_back(pr.link_a);
+      }
       continue;
     }
     if (d.distance < worst_free) worst_free = d.distance, worst_name = collision_.describe(d.pair);
-    if (d.distance < 0)
+    if (d.distance < 0) {
       p.violations.push_back(collision_.describe(d.pair) + fmt(": penetration %.2f mm", -d.distance * 1e3));
+      p.links.push_back(pr.link_a);
+      if (pr.kind == CollisionPair::Kind::Self) p.links.push_back(pr.link_b);
+    }
   }
   std::ostringstream os;
   os << collision_.numRobotEnvironmentPairs() << " robot-environment and " << collision_.numSelfPairs()
