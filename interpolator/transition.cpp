@@ -130,6 +130,10 @@ struct TransitionSolver::Attempt {
   double posture_seconds = 0;
   int refinements = 0;
   std::string reason;
+  // The robot links the failing check named, when the attempt failed on a
+  // check (a collision) and not on a posture the generator could not find.
+  std::vector<int> failed_links;
+  int attempts = 0;  // solveFixed's and solveMove's calls
   bool cancelled = false;
   std::vector<MotionPiece> pieces;
   // The moving body off its path, as a pendulum's (solve(), last stage).
@@ -187,13 +191,24 @@ struct Refiner {
   // Per segment of the refined knots: whether it lies on a bridge (its
   // refinements in verify() are bridge knots too).
   std::vector<bool> bridged;
+  // Set with `reason` when a check fails: the links it names (CheckPart::links).
+  std::vector<int>* failed_links;
 
-  bool midValid(const Configuration& a, const Configuration& b, std::string* why) {
+  // The failing parts of a report: the last one's first violation, and the links they name.
+  static void failure(const ValidityReport& r, std::string* why, std::vector<int>* links) {
+    links->clear();
+    for (const auto& p : r.parts)
+      if (p.checked && !p.ok()) {
+        *why = p.name + ": " + p.violations[0];
+        links->insert(links->end(), p.links.begin(), p.links.end());
+      }
+  }
+
+  bool midValid(const Configuration& a, const Configuration& b, std::string* why, std::vector<int>* links) {
     for (int i = 1; i <= checks; ++i) {
       const ValidityReport r = checker.checkPosture(lerp(a, b, static_cast<double>(i) / (checks + 1)), contacts);
       if (r.valid()) continue;
-      for (const auto& p : r.parts)
-        if (p.checked && !p.ok()) *why = p.name + ": " + p.violations[0];
+      failure(r, why, links);
       return false;
     }
     return true;
@@ -205,7 +220,8 @@ struct Refiner {
                std::vector<Configuration>& out, std::vector<double>& out_params, bool converging = false,
                bool bridging = false) {
     std::string why;
-    if (midValid(a, b, &why)) {
+    std::vector<int> links;
+    if (midValid(a, b, &why, &links)) {
       out.push_back(b);
       out_params.push_back(pb);
       bridged.push_back(bridging);
@@ -221,6 +237,7 @@ struct Refiner {
       if (!bridges || level >= kMaxBridgeDepth || (bridging && !converging)) {
         *reason = "between two knots, after " + std::to_string(level) + " refinements" +
                   (bridging ? " (bridged)" : "") + ": " + why;
+        *failed_links = std::move(links);
         return false;
       }
       bridging = true;
@@ -265,14 +282,14 @@ struct Refiner {
       const TimedPiece tp(knots, robot, kin, tl);
       std::set<int> bad;
       std::string why;
+      std::vector<int> links;
       for (int i = 0; i <= tp.steps(); ++i) {
         const int seg = tp.segmentAt(i * tl.dt);
         if (bad.count(seg)) continue;
         const ValidityReport r = checker.checkPosture(tp.at(i * tl.dt), contacts);
         if (r.valid()) continue;
         bad.insert(seg);
-        for (const auto& p : r.parts)
-          if (p.checked && !p.ok()) why = p.name + ": " + p.violations[0];
+        failure(r, &why, &links);
       }
       if (bad.empty()) return true;
       // A sample's violation shrinks with its segment (a finger grazing the
@@ -280,6 +297,7 @@ struct Refiner {
       // one knot per failing segment.
       if (round >= std::max(depth, kMaxDepth)) {
         *reason = "a sample between two knots, after " + std::to_string(round) + " rounds of refinement: " + why;
+        *failed_links = std::move(links);
         return false;
       }
       for (auto it = bad.rbegin(); it != bad.rend(); ++it) {  // from the last, so that indices stay valid
@@ -324,25 +342,37 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     // with the knots near the witnesses', then each also near its neighbour.
     std::string reasons;
     std::vector<LimbJointPath> limbs;
-    for (int attempt = 0; attempt < 6 && !out.ok && !at.cancelled; ++attempt) {
+    bool limbs_planned = false;
+    const char* what[] = {"as planned", "each knot near its neighbour too", "with more clearance",
+                          "with more clearance, each knot near its neighbour", "with the free limbs' joints planned",
+                          "with the free limbs' joints planned, each knot near its neighbour"};
+    // A first failure that lies with the free limbs alone (an arm the
+    // witnesses' interpolation sweeps through the table) goes to their planned
+    // joints next, before the attempts that change the knots of the whole body.
+    std::vector<int> order{0, 1, 2, 3, 4, 5};
+    for (std::size_t k = 0; k < order.size() && !out.ok && !at.cancelled; ++k) {
+      const int attempt = order[k];
       const bool follow = attempt % 2 == 1, wide = attempt == 2 || attempt == 3, planned = attempt >= 4;
       if (wide && !wide_generator_) continue;
-      if (planned && attempt == 4) {
-        if (!opt_.free_limb_paths || !opt_.limb_joint_paths) break;
-        const Configuration& q0 = plan.stances[fd.from].configuration;
-        const Configuration& q1 = plan.stances[fd.to].configuration;
-        for (int e : freeLimbEnds(fd))
-          if (auto l = plannedLimbJoints(q0, q1, sc_.robot->spotLimbRootJoint(e))) limbs.push_back(std::move(*l));
-        if (limbs.empty()) break;
+      if (planned && !limbs_planned) {
+        limbs_planned = true;
+        if (opt_.free_limb_paths && opt_.limb_joint_paths) {
+          const Configuration& q0 = plan.stances[fd.from].configuration;
+          const Configuration& q1 = plan.stances[fd.to].configuration;
+          for (int e : freeLimbEnds(fd))
+            if (auto l = plannedLimbJoints(q0, q1, sc_.robot->spotLimbRootJoint(e))) limbs.push_back(std::move(*l));
+        }
       }
+      if (planned && limbs.empty()) continue;
       at.pieces.clear();
       out.ok = solveFixed(plan, fd, follow, wide, planned ? limbs : std::vector<LimbJointPath>{}, at);
       out.repaired = out.ok && attempt > 0;
+      if (out.ok) out.how = what[attempt];
       if (!out.ok && !at.cancelled) {
-        const char* what[] = {"", "each knot near its neighbour too: ", "with more clearance: ",
-                              "with more clearance, each knot near its neighbour: ", "with the free limbs' joints planned: ",
-                              "with the free limbs' joints planned, each knot near its neighbour: "};
-        reasons += (reasons.empty() ? "" : "; ") + std::string(what[attempt]) + at.reason;
+        reasons += (reasons.empty() ? "" : "; ") + (attempt > 0 ? std::string(what[attempt]) + ": " : "") + at.reason;
+        if (attempt == 0 && opt_.free_limbs_first && opt_.free_limb_paths && opt_.limb_joint_paths &&
+            onFreeLimbsOnly(fd, at.failed_links))
+          order = {0, 4, 1, 2, 3, 5};
       }
     }
     if (!out.ok && !at.cancelled && opt_.bridge_jumps) {
@@ -351,6 +381,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       out.ok = solveFixed(plan, fd, false, false, {}, at);
       at.bridges = false;
       out.repaired = out.ok;
+      if (out.ok) out.how = "with bridges across branch jumps";
       if (!out.ok && !at.cancelled) reasons += "; with bridges across branch jumps: " + at.reason;
     }
     if (!out.ok && !at.cancelled) at.reason = reasons;
@@ -385,43 +416,49 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     std::string reasons;
     // The body's path planned with OMPL, once, when the splines have failed.
     std::optional<BodyPathPlan> planned;
-    auto tryPaths = [&](const std::vector<FreeEnd>* free, const std::string& label) {
-      for (int attempt = 0; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt) {
-        at.pieces.clear();
-        const double h = attempt * opt_.repair_step;
-        // A repair: the bridge raised by h, or a detour h to either side (the
-        // bridge moved sideways, or one via-point a quarter, half or three
-        // quarters of the way), whichever carries the body farthest from the
-        // obstacles and the held links (the raised one on a tie). Raising alone
-        // does not get a foot past a post; a foot between a post and the other
-        // foot has to step sideways first, then back.
-        BodyPath p = path;
-        std::string how = "as planned";
-        if (attempt > 0) {
-          double best = -std::numeric_limits<double>::infinity();
-          auto consider = [&](BodyPath candidate, std::string label) {
-            const double c = sweepClearance(candidate, *sc_.robot, *sc_.scene, d.spot, held);
-            if (c > best + 1e-9) best = c, p = std::move(candidate), how = std::move(label);
-          };
-          char buf[96];
-          std::snprintf(buf, sizeof buf, "via-point %.2f m up", h);
-          consider(path.raised(h), buf);
-          for (double side : {1.0, -1.0}) {
-            const char* name = side > 0 ? "left" : "right";
-            std::snprintf(buf, sizeof buf, "detour %.2f m %s", h, name);
-            consider(path.bridged(0, side * h), buf);
-            for (double f : {0.25, 0.5, 0.75}) {
-              std::snprintf(buf, sizeof buf, "detour %.2f m %s at %.2f of the way", h, name, f);
-              consider(path.detoured(f, side * h), buf);
-            }
+    // One attempt on the body's path: as planned (attempt 0), or repaired.
+    auto tryAttempt = [&](const std::vector<FreeEnd>* free, const std::string& label, int attempt) {
+      at.pieces.clear();
+      const double h = attempt * opt_.repair_step;
+      // A repair: the bridge raised by h, or a detour h to either side (the
+      // bridge moved sideways, or one via-point a quarter, half or three
+      // quarters of the way), whichever carries the body farthest from the
+      // obstacles and the held links (the raised one on a tie). Raising alone
+      // does not get a foot past a post; a foot between a post and the other
+      // foot has to step sideways first, then back.
+      BodyPath p = path;
+      std::string how = "as planned";
+      if (attempt > 0) {
+        double best = -std::numeric_limits<double>::infinity();
+        auto consider = [&](BodyPath candidate, std::string label) {
+          const double c = sweepClearance(candidate, *sc_.robot, *sc_.scene, d.spot, held);
+          if (c > best + 1e-9) best = c, p = std::move(candidate), how = std::move(label);
+        };
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "via-point %.2f m up", h);
+        consider(path.raised(h), buf);
+        for (double side : {1.0, -1.0}) {
+          const char* name = side > 0 ? "left" : "right";
+          std::snprintf(buf, sizeof buf, "detour %.2f m %s", h, name);
+          consider(path.bridged(0, side * h), buf);
+          for (double f : {0.25, 0.5, 0.75}) {
+            std::snprintf(buf, sizeof buf, "detour %.2f m %s at %.2f of the way", h, name, f);
+            consider(path.detoured(f, side * h), buf);
           }
         }
-        if (solveMove(plan, d, p, opt_.air_orientation_tolerance, free, at)) {
-          out.repaired = attempt > 0 || free;
-          return true;
-        }
-        reasons += (reasons.empty() ? "" : "; ") + label + how + ": " + at.reason;
       }
+      if (solveMove(plan, d, p, opt_.air_orientation_tolerance, free, at)) {
+        out.repaired = attempt > 0 || free;
+        out.how = label + how;
+        return true;
+      }
+      reasons += (reasons.empty() ? "" : "; ") + label + how + ": " + at.reason;
+      return false;
+    };
+    // Attempts `first` to the last, then the body's path planned with OMPL.
+    auto tryPaths = [&](const std::vector<FreeEnd>* free, const std::string& label, int first) {
+      for (int attempt = first; attempt <= opt_.repair_attempts && !at.cancelled; ++attempt)
+        if (tryAttempt(free, label, attempt)) return true;
       // Last, the body's path planned with OMPL: through a gap no spline
       // passes, its orientation planned with it and followed closely (the
       // orientation left free, the knots turn the body one way, then the
@@ -438,30 +475,60 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       }
       if (solveMove(plan, d, *planned->path, opt_.planned_orientation_tolerance, free, at)) {
         out.repaired = true;
+        out.how = label + "a path planned by OMPL";
         return true;
       }
       reasons += "; " + label + "a path planned by OMPL through " + std::to_string(planned->path->vias().size()) +
                  " waypoints: " + at.reason;
       return false;
     };
-    out.ok = tryPaths(nullptr, "");
-    // Then each again with the free limbs on paths of their own (freeEnds):
-    // a free foot that the witnesses' interpolation swings into the other
-    // foot or a chair's leg.
-    std::vector<FreeEnd> free;
-    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths) {
-      free = freeEnds(plan, d);
-      if (!free.empty()) out.ok = tryPaths(&free, "with the free limbs on their own paths, ");
+    // The stages, each its attempts: the body's path alone; then with the
+    // free limbs on paths of their own (freeEnds: a free foot that the
+    // witnesses' interpolation swings into the other foot or a chair's leg);
+    // then with the joints of each free limb that their interpolation sweeps
+    // through an obstacle planned (an elbow through a table's edge, which no
+    // path of the hand alone keeps clear). Every attempt of every stage is
+    // made until one succeeds; only their order can change, so the verdict
+    // does not depend on it. The body's path as planned comes first; when it
+    // fails on the free limbs alone (the free right hand through a chair's
+    // back while a foot steps), the free limbs' stages are tried as planned
+    // next, before the repairs of the body's path, which do not move them out
+    // of the way (chair_paper's OMPL-guided plan: its 35 -> 37 went through
+    // five of those, 3.3 s, before its free limbs' stage succeeded).
+    const char* free_label = "with the free limbs on their own paths, ";
+    const char* joints_label = "with the free limbs' joints planned, ";
+    const bool free_stages = opt_.repair_attempts > 0 && opt_.free_limb_paths;
+    const bool joint_stage = free_stages && opt_.limb_joint_paths;
+    // Each stage's free limbs found when it is first tried (a limb with no
+    // joint path costs seconds of state checks).
+    std::vector<FreeEnd> free, with_joints;
+    bool free_made = false, joints_made = false;
+    auto freeStage = [&]() -> const std::vector<FreeEnd>& {
+      if (!free_made) free = freeEnds(plan, d), free_made = true;
+      return free;
+    };
+    auto jointStage = [&]() -> const std::vector<FreeEnd>& {
+      if (!joints_made) {
+        joints_made = true;
+        with_joints = withPlannedJoints(plan, d, freeStage());
+        if (std::none_of(with_joints.begin(), with_joints.end(), [](const FreeEnd& f) { return f.joints.has_value(); }))
+          with_joints.clear();  // no limb planned: nothing this stage would change
+      }
+      return with_joints;
+    };
+    out.ok = tryAttempt(nullptr, "", 0);
+    const bool free_first = !out.ok && !at.cancelled && free_stages && opt_.free_limbs_first &&
+                            onFreeLimbsOnly(d, at.failed_links);
+    if (free_first) {
+      if (!freeStage().empty()) out.ok = tryAttempt(&free, free_label, 0);
+      if (!out.ok && !at.cancelled && joint_stage && !jointStage().empty())
+        out.ok = tryAttempt(&with_joints, joints_label, 0);
     }
-    // Last, with the joints of each free limb that their interpolation
-    // sweeps through an obstacle planned (an elbow through a table's edge,
-    // which no path of the hand alone keeps clear).
-    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths && opt_.limb_joint_paths) {
-      const std::vector<FreeEnd> planned = withPlannedJoints(plan, d, free);
-      const bool planned_joints =
-          std::any_of(planned.begin(), planned.end(), [](const FreeEnd& f) { return f.joints.has_value(); });
-      if (planned_joints) out.ok = tryPaths(&planned, "with the free limbs' joints planned, ");
-    }
+    const int first = free_first ? 1 : 0;
+    if (!out.ok && !at.cancelled) out.ok = tryPaths(nullptr, "", 1);
+    if (!out.ok && !at.cancelled && free_stages && !freeStage().empty()) out.ok = tryPaths(&free, free_label, first);
+    if (!out.ok && !at.cancelled && joint_stage && !jointStage().empty())
+      out.ok = tryPaths(&with_joints, joints_label, first);
     // Last, a body on a limb that holds no other contact (a forearm lifted
     // off the table, the hand beyond it free) leaves its path: held only where
     // it touches (as a foot hanging from its thigh, hangsFromItsLimb), its
@@ -471,10 +538,8 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     // that turn it about the elbow asks the shoulder for places the seated
     // trunk cannot give (a chair plan: no posture at 0.3 of the path,
     // whichever via-point).
-    if (!out.ok && !at.cancelled && opt_.repair_attempts > 0 && opt_.free_limb_paths && opt_.limb_joint_paths &&
-        onFreeLimb(d)) {
-      // `free`: freeEnds', found for the stage with the free limbs on their own paths (run whenever this one is).
-      std::vector<FreeEnd> limbs = withPlannedJoints(plan, d, free);
+    if (!out.ok && !at.cancelled && joint_stage && onFreeLimb(d)) {
+      std::vector<FreeEnd> limbs = withPlannedJoints(plan, d, freeStage());
       const Configuration& q0 = plan.stances[d.from].configuration;
       const Configuration& q1 = plan.stances[d.to].configuration;
       const int root = sc_.robot->spotLimbRootJoint(d.spot);
@@ -486,6 +551,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       out.ok = solveMove(plan, d, BodyPath(e0, e1, 2 * kPendulumTouch), opt_.air_orientation_tolerance, &limbs, at);
       at.free_body = false;
       out.repaired = out.ok;
+      if (out.ok) out.how = "the body free in the air, its limb's joints interpolated";
       if (!out.ok && !at.cancelled) reasons += "; the body free in the air, its limb's joints interpolated: " + at.reason;
     }
     // Last, the path as planned with each jump between two branches of the
@@ -499,6 +565,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       out.ok = solveMove(plan, d, path, opt_.air_orientation_tolerance, nullptr, at);
       at.bridges = false;
       out.repaired = out.ok;
+      if (out.ok) out.how = "as planned, with bridges across branch jumps";
       if (!out.ok && !at.cancelled) reasons += "; as planned, with bridges across branch jumps: " + at.reason;
     }
     if (!out.ok && !at.cancelled)
@@ -509,6 +576,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   out.posture_calls = at.posture_calls;
   out.posture_seconds = at.posture_seconds;
   out.refinements = at.refinements;
+  out.attempts = at.attempts;
   out.pieces = std::move(at.pieces);
   if (!out.ok) out.pieces.clear();
   return out;
@@ -550,6 +618,8 @@ std::optional<TransitionDesign> TransitionSolver::stillBody(const Plan& plan, co
 bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, bool follow, bool wide,
                                   const std::vector<LimbJointPath>& limbs, Attempt& at) {
   PostureGenerator& generator = wide ? *wide_generator_ : generator_;
+  at.failed_links.clear();
+  ++at.attempts;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   if (distance(q0, q1) < 1e-9) return true;  // the witnesses coincide: only the contacts' support changes
@@ -608,7 +678,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   piece.contacts = d.motion_contacts;
   piece.stance = d.motion_stance;
   Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks,
-              at.bridges, {}};
+              at.bridges, {}, &at.failed_links};
   std::vector<double> piece_params;
   if (!ref.refine(params, knots, piece.knots, piece_params)) return false;
   if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;
@@ -741,6 +811,15 @@ bool TransitionSolver::onFreeLimb(const TransitionDesign& d) const {
   return true;
 }
 
+bool TransitionSolver::onFreeLimbsOnly(const TransitionDesign& d, const std::vector<int>& links) const {
+  if (links.empty()) return false;
+  const RobotModel& m = *sc_.robot;
+  const std::vector<int> ends = freeLimbEnds(d);
+  return std::all_of(links.begin(), links.end(), [&](int link) {
+    return std::any_of(ends.begin(), ends.end(), [&](int e) { return m.jointMovesLink(m.spotLimbRootJoint(e), link); });
+  });
+}
+
 std::vector<PlacedShape> TransitionSolver::outsideLimb(const Configuration& q, int spot) {
   const RobotModel& m = *sc_.robot;
   const int link = m.spots()[spot].link, root = m.limbRootJoint(link);
@@ -754,6 +833,8 @@ std::vector<PlacedShape> TransitionSolver::outsideLimb(const Configuration& q, i
 
 bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path,
                                  double orientation_tolerance, const std::vector<FreeEnd>* free_ends, Attempt& at) {
+  at.failed_links.clear();
+  ++at.attempts;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
   std::vector<int> touch;
@@ -913,7 +994,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     piece.contacts = contacts;
     piece.stance = stance;
     Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks,
-                at.bridges, {}};
+                at.bridges, {}, &at.failed_links};
     std::vector<double> piece_params;
     if (!ref.refine(ps, ks, piece.knots, piece_params)) return false;
     if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;

@@ -112,6 +112,13 @@ struct TransitionOptions {
   // (limb_path_planner.h) and the knots follow them instead of its end's path.
   bool limb_joint_paths = true;
   double free_limb_weight = 100;
+  // Where the first attempt fails on the free limbs alone (the collisions
+  // its check found all on links of limbs with no contact), the free limbs'
+  // stages are tried next, before the repairs that change the moving body's
+  // path or the whole body's knots, which do not move those limbs out of the
+  // way. Only the order of the attempts changes (each is still made until one
+  // succeeds), so a transition is solved or not alike; off: the order above.
+  bool free_limbs_first = true;
   // A fixed-contact transition whose knots cannot be made valid at the
   // posture generator's collision margin is solved once more with this much
   // more clearance for its knots (m; 0: no such try). Knots that hug an
@@ -144,6 +151,8 @@ struct TransitionOutcome {
   long posture_calls = 0;
   double posture_seconds = 0;        // wall time inside the posture generator
   bool repaired = false;
+  std::string how;                   // when solved: "as planned", or the repair that made it
+  int attempts = 0;                  // attempts made (each solves its knots anew)
   int refinements = 0;               // knots inserted between the n steps
 };
 
@@ -184,6 +193,9 @@ class TransitionSolver {
                                               bool touching_ends);
   // Whether the Move's body is on a limb that holds no contact during the motion (a forearm, its arm free).
   bool onFreeLimb(const TransitionDesign& d) const;
+  // Whether every one of `links` (a failed check's, Attempt::failed_links)
+  // is moved by a free limb's joints (freeLimbEnds); false for none.
+  bool onFreeLimbsOnly(const TransitionDesign& d, const std::vector<int>& links) const;
   // A Move whose body already touches its surface in both witnesses, as the
   // Fixed transition that holds it touching; none for any other.
   std::optional<TransitionDesign> stillBody(const Plan& plan, const TransitionDesign& d);

@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <functional>
+#include <utility>
 
 #include "interpolator/body_path.h"
 #include "interpolator/body_path_planner.h"
@@ -1283,4 +1284,71 @@ TEST(PlanVerifier, RefusesWhatTheInterpolatorCannotDoAndRemembersWhatItSolved) {
   const PlanVerdict stopped = fresh.verify(plan, stop);
   EXPECT_TRUE(stopped.stopped);
   EXPECT_FALSE(stopped.ok());
+}
+
+namespace {
+// Solves the one transition of a plan cut from chair_paper's plan on its
+// OMPL guide twice, the free limbs' stages first (the default) and in the
+// order that repairs the body's path first: both must solve it the same
+// way, the knots equal to the bit; returns both outcomes.
+std::pair<TransitionOutcome, TransitionOutcome> solveInBothOrders(const std::string& file) {
+  const Scenario& sc = paperChairScenario();
+  const Plan plan = readPlan(test::sourcePath("tests/data/" + file), sc);
+  std::vector<int> kept(plan.stances.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) kept[i] = static_cast<int>(i);
+  std::vector<TransitionDesign> designs;
+  EXPECT_EQ(designTransitions(plan, kept, designs), "");
+  EXPECT_EQ(designs.size(), 1u);
+  if (designs.size() != 1) return {};
+  InterpolatorOptions io;
+  io.filter = false;
+  TransitionOptions free_first = transitionOptions(withScenarioMargins(sc, io));
+  TransitionOptions body_first = free_first;
+  EXPECT_TRUE(free_first.free_limbs_first);  // the default
+  body_first.free_limbs_first = false;
+  TransitionSolver a(sc, free_first), b(sc, body_first);
+  std::pair<TransitionOutcome, TransitionOutcome> r{a.solve(plan, designs[0]), b.solve(plan, designs[0])};
+  const TransitionOutcome& fa = r.first;
+  const TransitionOutcome& fb = r.second;
+  EXPECT_TRUE(fa.ok) << fa.reason;
+  EXPECT_TRUE(fb.ok) << fb.reason;
+  EXPECT_EQ(fa.how, fb.how);
+  EXPECT_EQ(fa.pieces.size(), fb.pieces.size());
+  for (std::size_t p = 0; p < std::min(fa.pieces.size(), fb.pieces.size()); ++p) {
+    EXPECT_EQ(fa.pieces[p].knots.size(), fb.pieces[p].knots.size()) << p;
+    for (std::size_t k = 0; k < std::min(fa.pieces[p].knots.size(), fb.pieces[p].knots.size()); ++k) {
+      EXPECT_EQ(fa.pieces[p].knots[k].joints, fb.pieces[p].knots[k].joints) << p << " " << k;
+      EXPECT_EQ(fa.pieces[p].knots[k].base_position, fb.pieces[p].knots[k].base_position) << p << " " << k;
+    }
+  }
+  return r;
+}
+}  // namespace
+
+TEST(TransitionSolver, AStepWhoseFreeHandGrazesTheChairsBackTriesTheFreeLimbsStageSecond) {
+  // On the left palm and the right sole, the left foot steps while the free
+  // right hand passes the chair's back. As planned, the hand grazes the back
+  // (the failed check names only the right arm's links); raising or
+  // detouring the foot's path leaves the hand where it was, and the stage
+  // with the free limbs on paths of their own solves it. Free limbs first,
+  // that is the second attempt; the body's path first, after its four
+  // repairs and OMPL's path for the foot. The same attempt, the same knots.
+  const auto [free_first, body_first] = solveInBothOrders("chair_paper_ompl_step_hand_by_chair_back.plan.json");
+  EXPECT_EQ(free_first.how, "with the free limbs on their own paths, as planned");
+  EXPECT_EQ(free_first.attempts, 2);
+  EXPECT_EQ(body_first.attempts, 7);
+  EXPECT_LT(free_first.posture_calls, body_first.posture_calls);
+}
+
+TEST(TransitionSolver, AWeightShiftWhoseFreeArmCutsTheTablePlansItsJointsSecond) {
+  // On both soles, the weight leaves the right wrist on the table while the
+  // free left arm comes over the table's top: its joints' interpolation
+  // takes the hand into the top (the failed check names only the left arm's
+  // links). Free limbs first, the arm's joints are planned on the second
+  // attempt; whole body first, after the knots near their neighbours and with
+  // more clearance (three attempts more). The same attempt, the same knots.
+  const auto [free_first, body_first] = solveInBothOrders("chair_paper_ompl_wrist_unloaded_arm_over_table.plan.json");
+  EXPECT_EQ(free_first.how, "with the free limbs' joints planned");
+  EXPECT_EQ(free_first.attempts, 2);
+  EXPECT_EQ(body_first.attempts, 5);
 }
