@@ -67,6 +67,18 @@ struct InterpolationProgress {
   std::string stage;                    // "filtering", "transitions", "timing"
 };
 
+// One transition the interpolator solved, or the one it could not: how it
+// was made and what it cost (acyclic-interpolator --verbose prints these).
+struct TransitionRecord {
+  int from = 0, to = 0;                 // stance indices
+  bool move = false;                    // a body moves (else a fixed-contact transition)
+  bool ok = false;
+  std::string how;                      // the attempt that made it (TransitionOutcome::how)
+  int attempts = 0;
+  long posture_calls = 0;
+  double seconds = 0;                   // wall time of its solve (while filtering, for a kept pair it solved then)
+};
+
 struct InterpolationResult {
   enum class Status { Success, InvalidInput, Unrepairable, TransitionFailed, Cancelled };
   Status status = Status::InvalidInput;
@@ -76,6 +88,9 @@ struct InterpolationResult {
   int filtered = 0;                     // stances dropped
   int refinements = 0;                  // knots inserted between steps
   double posture_seconds = 0;           // of the wall time, inside the posture generator
+  // The transitions solved, in the plan's order, up to and with the one that
+  // failed (none when the filtering or the design failed first).
+  std::vector<TransitionRecord> transitions;
   bool success() const { return status == Status::Success; }
 };
 

@@ -1,6 +1,7 @@
 #include "interpolator/transition.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -318,6 +319,7 @@ struct Refiner {
 }  // namespace
 
 TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesign& d, const std::atomic<bool>* cancel) {
+  const auto t0 = std::chrono::steady_clock::now();
   TransitionOutcome out;
   Attempt at;
   at.cancel = cancel;
@@ -579,6 +581,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   out.attempts = at.attempts;
   out.pieces = std::move(at.pieces);
   if (!out.ok) out.pieces.clear();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 

@@ -150,6 +150,7 @@ struct TransitionOutcome {
   std::vector<MotionPiece> pieces;
   long posture_calls = 0;
   double posture_seconds = 0;        // wall time inside the posture generator
+  double seconds = 0;                // wall time of the whole solve
   bool repaired = false;
   std::string how;                   // when solved: "as planned", or the repair that made it
   int attempts = 0;                  // attempts made (each solves its knots anew)

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
       "plan at a time: a plan that arrives while one is interpolated is refused (ACYCLIC_TRAJECTORY with\n"
       "status ERROR and the reason). Exits 0 on SIGINT/SIGTERM."};
   std::string in, out, scenario_path;
-  bool no_filter = false, quiet = false;
+  bool no_filter = false, quiet = false, verbose = false;
   bool lcm_mode = false;
   std::string url = acyclic::proc::defaultLcmUrl();
   app.add_option("--in", in, "plan file (acyclic.plan/1), file mode");
@@ -80,6 +80,10 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
+  app.add_flag("-v,--verbose", verbose,
+               "file mode: one line per transition solved on stderr, in the plan's order (its stances, the attempt "
+               "that made it or none, attempts, posture calls, seconds), to see which needed repairs and what they "
+               "cost");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
   o.filter = !no_filter;
   // The scenario's margins unless the command line gives them.
@@ -121,6 +125,12 @@ int main(int argc, char** argv) {
     };
     acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, options_for(sc), progress, &g_stop);
     if (tty) std::fprintf(stderr, "\n");
+    if (verbose)
+      for (const acyclic::TransitionRecord& t : r.transitions)
+        std::fprintf(stderr, "acyclic-interpolator: transition %d -> %d (%s): %s; %d attempt%s, %ld posture calls, %.2f s\n",
+                     t.from, t.to, t.move ? "a body moves" : "contacts fixed",
+                     t.ok ? t.how.c_str() : "not made", t.attempts, t.attempts == 1 ? "" : "s", t.posture_calls,
+                     t.seconds);
     if (!r.success()) {
       std::printf("acyclic-interpolator: %s: %s: %s\n", in.c_str(), acyclic::toString(r.status), r.reason.c_str());
       return r.status == acyclic::InterpolationResult::Status::InvalidInput ? 2 : 1;

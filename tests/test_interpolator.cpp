@@ -1352,3 +1352,29 @@ TEST(TransitionSolver, AWeightShiftWhoseFreeArmCutsTheTablePlansItsJointsSecond)
   EXPECT_EQ(free_first.attempts, 2);
   EXPECT_EQ(body_first.attempts, 5);
 }
+
+TEST(InterpolatorProcess, VerboseSaysHowEachTransitionWasMadeAndWhatItCost) {
+  // The step of chair_paper's OMPL plan whose free hand grazes the chair's
+  // back (above): --verbose names the repair that made it, after how many
+  // attempts; without it, no such line.
+  const std::string interp = test::binaryPath("processes/acyclic-interpolator");
+  test::TempDir dir;
+  const std::string cmd = interp + " -q --no-filter --threads 1 --scenario " +
+                          test::sourcePath("models/scenarios/chair_paper.yaml") + " --in " +
+                          test::sourcePath("tests/data/chair_paper_ompl_step_hand_by_chair_back.plan.json") +
+                          " --out " + dir.path() + "/t.json";
+  const auto run = test::runProcess(cmd + " -v");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("transition 0 -> 2 (a body moves): with the free limbs on their own paths, as planned; "
+                            "2 attempts, "),
+            std::string::npos)
+      << run.output;
+  std::size_t lines = 0;
+  for (std::size_t at = run.output.find("acyclic-interpolator: transition "); at != std::string::npos;
+       at = run.output.find("acyclic-interpolator: transition ", at + 1))
+    ++lines;
+  EXPECT_EQ(lines, 1u) << run.output;  // one transition in that plan
+  const auto quiet = test::runProcess(cmd);
+  ASSERT_EQ(quiet.status, 0) << quiet.output;
+  EXPECT_EQ(quiet.output.find("acyclic-interpolator: transition "), std::string::npos) << quiet.output;
+}
