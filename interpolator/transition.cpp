@@ -134,6 +134,9 @@ struct TransitionSolver::Attempt {
   // The robot links the failing check named, when the attempt failed on a
   // check (a collision) and not on a posture the generator could not find.
   std::vector<int> failed_links;
+  // Set when the attempt failed on a segment that no halving shortened (a
+  // jump between two branches of the inverse kinematics), which bridges close.
+  bool jumped = false;
   int attempts = 0;  // solveFixed's and solveMove's calls
   bool cancelled = false;
   std::vector<MotionPiece> pieces;
@@ -194,6 +197,9 @@ struct Refiner {
   std::vector<bool> bridged;
   // Set with `reason` when a check fails: the links it names (CheckPart::links).
   std::vector<int>* failed_links;
+  // Set with `reason` when a segment fails unbridged and its last halving did
+  // not converge (what bridges would have taken on).
+  bool* jumped;
 
   // The failing parts of a report: the last one's first violation, and the links they name.
   static void failure(const ValidityReport& r, std::string* why, std::vector<int>* links) {
@@ -239,6 +245,7 @@ struct Refiner {
         *reason = "between two knots, after " + std::to_string(level) + " refinements" +
                   (bridging ? " (bridged)" : "") + ": " + why;
         *failed_links = std::move(links);
+        *jumped = !bridges && !converging;
         return false;
       }
       bridging = true;
@@ -345,16 +352,18 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     std::string reasons;
     std::vector<LimbJointPath> limbs;
     bool limbs_planned = false;
+    // Last, the knots as planned with each jump between two branches bridged.
     const char* what[] = {"as planned", "each knot near its neighbour too", "with more clearance",
                           "with more clearance, each knot near its neighbour", "with the free limbs' joints planned",
-                          "with the free limbs' joints planned, each knot near its neighbour"};
-    // A first failure that lies with the free limbs alone (an arm the
-    // witnesses' interpolation sweeps through the table) goes to their planned
-    // joints next, before the attempts that change the knots of the whole body.
+                          "with the free limbs' joints planned, each knot near its neighbour",
+                          "with bridges across branch jumps"};
+    constexpr int kBridges = 6, kLimbsPlanned = 4;
     std::vector<int> order{0, 1, 2, 3, 4, 5};
+    if (opt_.bridge_jumps) order.push_back(kBridges);
     for (std::size_t k = 0; k < order.size() && !out.ok && !at.cancelled; ++k) {
       const int attempt = order[k];
-      const bool follow = attempt % 2 == 1, wide = attempt == 2 || attempt == 3, planned = attempt >= 4;
+      const bool follow = attempt % 2 == 1, wide = attempt == 2 || attempt == 3,
+                 planned = attempt == 4 || attempt == 5, bridged = attempt == kBridges;
       if (wide && !wide_generator_) continue;
       if (planned && !limbs_planned) {
         limbs_planned = true;
@@ -367,24 +376,31 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       }
       if (planned && limbs.empty()) continue;
       at.pieces.clear();
+      at.bridges = bridged;
       out.ok = solveFixed(plan, fd, follow, wide, planned ? limbs : std::vector<LimbJointPath>{}, at);
+      at.bridges = false;
       out.repaired = out.ok && attempt > 0;
       if (out.ok) out.how = what[attempt];
       if (!out.ok && !at.cancelled) {
         reasons += (reasons.empty() ? "" : "; ") + (attempt > 0 ? std::string(what[attempt]) + ": " : "") + at.reason;
-        if (attempt == 0 && opt_.free_limbs_first && opt_.free_limb_paths && opt_.limb_joint_paths &&
-            onFreeLimbsOnly(fd, at.failed_links))
-          order = {0, 4, 1, 2, 3, 5};
+        // A first failure that says which repair it needs gets it next: a
+        // collision of the free limbs alone (an arm the witnesses'
+        // interpolation sweeps through the table, its knots jumping across
+        // the edge) their planned joints, before the attempts that change the
+        // knots of the whole body; a jump between branches that drags or
+        // presses a held contact alone (a palm 3 mm off its point between two
+        // knots) its bridges.
+        if (attempt == 0 && opt_.order_by_failure) {
+          std::vector<int> next{0};
+          if (opt_.free_limb_paths && opt_.limb_joint_paths && onFreeLimbsOnly(fd, at.failed_links))
+            next.push_back(kLimbsPlanned);
+          else if (at.jumped && opt_.bridge_jumps && onHeldBodiesOnly(fd, at.failed_links))
+            next.push_back(kBridges);
+          for (int a : order)
+            if (std::find(next.begin(), next.end(), a) == next.end()) next.push_back(a);
+          order = std::move(next);
+        }
       }
-    }
-    if (!out.ok && !at.cancelled && opt_.bridge_jumps) {
-      at.pieces.clear();
-      at.bridges = true;
-      out.ok = solveFixed(plan, fd, false, false, {}, at);
-      at.bridges = false;
-      out.repaired = out.ok;
-      if (out.ok) out.how = "with bridges across branch jumps";
-      if (!out.ok && !at.cancelled) reasons += "; with bridges across branch jumps: " + at.reason;
     }
     if (!out.ok && !at.cancelled) at.reason = reasons;
   } else {
@@ -518,9 +534,38 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       }
       return with_joints;
     };
+    // The path as planned with each jump between two branches of the inverse
+    // kinematics bridged (Refiner::bridges): a right thigh moved while the
+    // left palm is held on the table, whose knots jump 0.006 apart in path
+    // parameter, the palm 1.39 mm into the table between them, whatever
+    // via-point or detour. Last, unless the first attempt's failure was such
+    // a jump.
+    bool bridges_tried = false;
+    auto tryBridges = [&]() {
+      bridges_tried = true;
+      at.pieces.clear();
+      at.bridges = true;
+      const bool ok = solveMove(plan, d, path, opt_.air_orientation_tolerance, nullptr, at);
+      at.bridges = false;
+      if (ok) {
+        out.repaired = true;
+        out.how = "as planned, with bridges across branch jumps";
+      } else if (!at.cancelled) {
+        reasons += (reasons.empty() ? "" : "; ") + std::string("as planned, with bridges across branch jumps: ") + at.reason;
+      }
+      return ok;
+    };
     out.ok = tryAttempt(nullptr, "", 0);
-    const bool free_first = !out.ok && !at.cancelled && free_stages && opt_.free_limbs_first &&
-                            onFreeLimbsOnly(d, at.failed_links);
+    // What the first failure says it needs, before the rest in their order.
+    const std::vector<int> first_links = at.failed_links;
+    // A jump that fails on the held contacts alone (a held palm pressed into
+    // the table between two knots) is bridged next; one of the moving body (a
+    // foot past a chair's leg, which a detour avoids) or of a free limb is not.
+    if (!out.ok && !at.cancelled && opt_.order_by_failure && opt_.bridge_jumps && at.jumped &&
+        onHeldBodiesOnly(d, first_links))
+      out.ok = tryBridges();
+    const bool free_first = !out.ok && !at.cancelled && free_stages && opt_.order_by_failure &&
+                            onFreeLimbsOnly(d, first_links);
     if (free_first) {
       if (!freeStage().empty()) out.ok = tryAttempt(&free, free_label, 0);
       if (!out.ok && !at.cancelled && joint_stage && !jointStage().empty())
@@ -556,20 +601,8 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       if (out.ok) out.how = "the body free in the air, its limb's joints interpolated";
       if (!out.ok && !at.cancelled) reasons += "; the body free in the air, its limb's joints interpolated: " + at.reason;
     }
-    // Last, the path as planned with each jump between two branches of the
-    // inverse kinematics bridged (Refiner::bridges): a right thigh moved
-    // while the left palm is held on the table, whose knots jump 0.006 apart
-    // in path parameter, the palm 1.39 mm into the table between them,
-    // whatever via-point or detour.
-    if (!out.ok && !at.cancelled && opt_.bridge_jumps) {
-      at.pieces.clear();
-      at.bridges = true;
-      out.ok = solveMove(plan, d, path, opt_.air_orientation_tolerance, nullptr, at);
-      at.bridges = false;
-      out.repaired = out.ok;
-      if (out.ok) out.how = "as planned, with bridges across branch jumps";
-      if (!out.ok && !at.cancelled) reasons += "; as planned, with bridges across branch jumps: " + at.reason;
-    }
+    // Last, the path as planned with its jumps bridged (tryBridges), unless already tried.
+    if (!out.ok && !at.cancelled && opt_.bridge_jumps && !bridges_tried) out.ok = tryBridges();
     if (!out.ok && !at.cancelled)
       at.reason = "the moving body's path (" + sc_.robot->spots()[d.spot].name + ") cannot be repaired: " + reasons;
   }
@@ -622,6 +655,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
                                   const std::vector<LimbJointPath>& limbs, Attempt& at) {
   PostureGenerator& generator = wide ? *wide_generator_ : generator_;
   at.failed_links.clear();
+  at.jumped = false;
   ++at.attempts;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
@@ -681,7 +715,7 @@ bool TransitionSolver::solveFixed(const Plan& plan, const TransitionDesign& d, b
   piece.contacts = d.motion_contacts;
   piece.stance = d.motion_stance;
   Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks,
-              at.bridges, {}, &at.failed_links};
+              at.bridges, {}, &at.failed_links, &at.jumped};
   std::vector<double> piece_params;
   if (!ref.refine(params, knots, piece.knots, piece_params)) return false;
   if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;
@@ -814,6 +848,16 @@ bool TransitionSolver::onFreeLimb(const TransitionDesign& d) const {
   return true;
 }
 
+bool TransitionSolver::onHeldBodiesOnly(const TransitionDesign& d, const std::vector<int>& links) const {
+  if (links.empty()) return false;
+  const RobotModel& m = *sc_.robot;
+  const int moving = d.spot >= 0 ? m.spots()[d.spot].link : -1;
+  return std::all_of(links.begin(), links.end(), [&](int link) {
+    return link != moving && std::any_of(d.motion_contacts.begin(), d.motion_contacts.end(),
+                                         [&](const ContactSpec& c) { return m.spots()[c.spot].link == link; });
+  });
+}
+
 bool TransitionSolver::onFreeLimbsOnly(const TransitionDesign& d, const std::vector<int>& links) const {
   if (links.empty()) return false;
   const RobotModel& m = *sc_.robot;
@@ -837,6 +881,7 @@ std::vector<PlacedShape> TransitionSolver::outsideLimb(const Configuration& q, i
 bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, const BodyPath& path,
                                  double orientation_tolerance, const std::vector<FreeEnd>* free_ends, Attempt& at) {
   at.failed_links.clear();
+  at.jumped = false;
   ++at.attempts;
   const Configuration& q0 = plan.stances[d.from].configuration;
   const Configuration& q1 = plan.stances[d.to].configuration;
@@ -997,7 +1042,7 @@ bool TransitionSolver::solveMove(const Plan& plan, const TransitionDesign& d, co
     piece.contacts = contacts;
     piece.stance = stance;
     Refiner ref{checker_, piece.contacts, solveAt, opt_.refine_depth, &at.refinements, &at.reason, opt_.segment_checks,
-                at.bridges, {}, &at.failed_links};
+                at.bridges, {}, &at.failed_links, &at.jumped};
     std::vector<double> piece_params;
     if (!ref.refine(ps, ks, piece.knots, piece_params)) return false;
     if (opt_.verify_samples && !ref.verify(piece_params, piece.knots, opt_.timing, *sc_.robot, kin_)) return false;

@@ -112,13 +112,16 @@ struct TransitionOptions {
   // (limb_path_planner.h) and the knots follow them instead of its end's path.
   bool limb_joint_paths = true;
   double free_limb_weight = 100;
-  // Where the first attempt fails on the free limbs alone (the collisions
-  // its check found all on links of limbs with no contact), the free limbs'
-  // stages are tried next, before the repairs that change the moving body's
-  // path or the whole body's knots, which do not move those limbs out of the
-  // way. Only the order of the attempts changes (each is still made until one
-  // succeeds), so a transition is solved or not alike; off: the order above.
-  bool free_limbs_first = true;
+  // Where the first attempt's failure says which repair it needs, that one
+  // is tried next: the free limbs' stages where the collisions its check
+  // found are all on links of limbs with no contact, before the repairs that
+  // change the moving body's path or the whole body's knots, which do not
+  // move those limbs out of the way; else bridges (bridge_jumps) where a
+  // segment no halving shortened (a jump between two branches of the inverse
+  // kinematics) fails on held contacts alone. Only the order of the attempts changes (each is still made
+  // until one succeeds), so a transition is solved or not alike; off: the
+  // order above.
+  bool order_by_failure = true;
   // A fixed-contact transition whose knots cannot be made valid at the
   // posture generator's collision margin is solved once more with this much
   // more clearance for its knots (m; 0: no such try). Knots that hug an
@@ -197,6 +200,9 @@ class TransitionSolver {
   // Whether every one of `links` (a failed check's, Attempt::failed_links)
   // is moved by a free limb's joints (freeLimbEnds); false for none.
   bool onFreeLimbsOnly(const TransitionDesign& d, const std::vector<int>& links) const;
+  // Whether every one of `links` is a held contact's (d.motion_contacts'),
+  // not the moving body's; false for none.
+  bool onHeldBodiesOnly(const TransitionDesign& d, const std::vector<int>& links) const;
   // A Move whose body already touches its surface in both witnesses, as the
   // Fixed transition that holds it touching; none for any other.
   std::optional<TransitionDesign> stillBody(const Plan& plan, const TransitionDesign& d);

@@ -81,6 +81,7 @@ CheckPart ValidityChecker::checkContacts(const std::vector<ContactSpec>& stance)
     const ContactSpot& spot = robot_->spots()[c.spot];
     const Surface& surf = scene_->surfaces()[c.surface];
     const std::string name = spot.name + "@" + surf.name;
+    const std::size_t before = p.violations.size();
     const Eigen::Isometry3d spot_w = kin_.spotPose(c.spot);
     const Eigen::Isometry3d target = contactFrame(surf, c.placement);
     const double pos = (spot_w.translation() - target.translation()).norm();
@@ -108,6 +109,7 @@ CheckPart ValidityChecker::checkContacts(const std::vector<ContactSpec>& stance)
         break;
       }
     }
+    if (p.violations.size() > before) p.links.push_back(spot.link);
   }
   std::ostringstream os;
   os << stance.size() << " contacts; worst position error " << fmt("%.3f", worst_pos * 1e3)

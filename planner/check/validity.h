@@ -28,8 +28,9 @@ struct CheckPart {
   bool checked = true;               // false: not available (says why in summary)
   std::vector<std::string> violations;
   // The robot links its violations name (collisions: each offending pair's
-  // robot link or links), for a caller that acts on which part of the body
-  // failed (the interpolator's order of repairs, transition.cpp).
+  // robot link or links; contacts: each violated contact's spot's link), for
+  // a caller that acts on which part of the body failed (the interpolator's
+  // order of repairs, transition.cpp).
   std::vector<int> links;
   std::string summary;               // what was checked and the worst figure
   bool ok() const { return violations.empty(); }
