@@ -2,9 +2,11 @@
 // posture generator), posture calls, repairs, filtered stances, samples, for
 // n = 10 and 20 steps, with every sample verified (the default) and without
 // (knots and segment middles only: what the verification costs), on one
-// thread and on two (whether both give the same trajectory is printed); then
-// the independent trajectory check of the default n = 20 run. Figures in
-// docs/figures.md.
+// thread and on two (whether both give the same trajectory is printed), and
+// on one thread with the repairs in their fixed order instead of the one a
+// first failure names (InterpolatorOptions::order_by_failure: the ratio of
+// wall times, and whether the trajectory is the same); then the independent
+// trajectory check of the default n = 20 run. Figures in docs/figures.md.
 // Usage: bench_interpolator [PLAN.json [SCENARIO]] [OPTIONS]; --help lists the options.
 //   Without a plan: plans models/scenarios/step_forward.yaml first. The
 //   scenario defaults to the plan's "scenario" field (relative to the plan's
@@ -36,7 +38,8 @@ int main(int argc, char** argv) {
   std::string plan_path, scenario_path;
   CLI::App app{"The trajectory interpolator on a plan: wall time (and its share in the posture generator), posture\n"
                "calls, repairs, filtered stances, samples, for n = 10 and 20 steps, with every sample verified and\n"
-               "without, on one thread and on two; then the independent trajectory check of the default n = 20 run."};
+               "without, on one thread and on two, and on one thread with the repairs in their fixed order; then the\n"
+               "independent trajectory check of the default n = 20 run."};
   app.add_option("plan", plan_path,
                  "plan file (acyclic.plan/1, JSON; default: plan models/scenarios/step_forward.yaml first)");
   app.add_option("scenario", scenario_path,
@@ -73,40 +76,53 @@ int main(int argc, char** argv) {
     plan = readPlan(plan_path, sc);
   }
   std::printf("plan %s: scenario %s, %zu stances\n", plan_path.c_str(), sc.name.c_str(), plan.stances.size());
-  std::printf("%3s %7s %7s %-16s %9s %9s %7s %8s %8s %8s %8s %9s\n", "n", "verify", "threads", "result", "wall s",
-              "posture s", "calls", "repairs", "filtered", "refined", "samples", "motion s");
-  InterpolationResult keep, one_thread;
+  std::printf("%3s %7s %7s %-7s %-16s %9s %9s %7s %8s %8s %8s %8s %9s\n", "n", "verify", "threads", "order",
+              "result", "wall s", "posture s", "calls", "repairs", "filtered", "refined", "samples", "motion s");
+  InterpolationResult keep, one_thread, fixed_order;
   struct Variant {
     int n;
     bool verify;
     int threads;
+    bool by_failure;  // InterpolatorOptions::order_by_failure
   };
-  for (const Variant v : {Variant{10, true, 2}, Variant{20, true, 1}, Variant{20, true, 2}, Variant{20, false, 2}}) {
+  for (const Variant v : {Variant{10, true, 2, true}, Variant{20, true, 1, true}, Variant{20, true, 1, false},
+                          Variant{20, true, 2, true}, Variant{20, false, 2, true}}) {
     const int n = v.n;
     const bool verify = v.verify;
     InterpolatorOptions o;
     o.steps = n;
     o.verify_samples = verify;
     o.threads = v.threads;
+    o.order_by_failure = v.by_failure;
     o.posture_ipopt_options = ipopt;
     o.collision_cutoff = cutoff;
     InterpolationResult r = interpolate(plan, sc, o);
     const auto& s = r.trajectory.stats;
-    std::printf("%3d %7s %7d %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, verify ? "yes" : "no",
-                v.threads, toString(r.status), s.seconds, r.posture_seconds, s.posture_calls, s.repairs, r.filtered,
-                r.refinements, r.trajectory.samples.size(), r.trajectory.duration());
+    std::printf("%3d %7s %7d %-7s %-16s %9.2f %9.2f %7ld %8d %8d %8d %8zu %9.2f\n", n, verify ? "yes" : "no",
+                v.threads, v.by_failure ? "failure" : "fixed", toString(r.status), s.seconds, r.posture_seconds,
+                s.posture_calls, s.repairs, r.filtered, r.refinements, r.trajectory.samples.size(),
+                r.trajectory.duration());
     if (!r.success()) std::printf("    reason: %s\n", r.reason.c_str());
     std::fflush(stdout);
-    if (n == 20 && verify && v.threads == 1) one_thread = std::move(r);
+    if (n == 20 && verify && v.threads == 1) (v.by_failure ? one_thread : fixed_order) = std::move(r);
     else if (n == 20 && verify) keep = std::move(r);
   }
-  if (keep.success() && one_thread.success()) {
-    bool same = keep.trajectory.samples.size() == one_thread.trajectory.samples.size();
-    for (std::size_t i = 0; same && i < keep.trajectory.samples.size(); ++i)
-      same = keep.trajectory.samples[i].q.joints == one_thread.trajectory.samples[i].q.joints &&
-             keep.trajectory.samples[i].q.base_position == one_thread.trajectory.samples[i].q.base_position;
-    std::printf("same trajectory on 1 and 2 threads (n = 20): %s\n", same ? "yes" : "NO");
-  }
+  auto same = [](const InterpolationResult& a, const InterpolationResult& b) {
+    bool same = a.trajectory.samples.size() == b.trajectory.samples.size();
+    for (std::size_t i = 0; same && i < a.trajectory.samples.size(); ++i)
+      same = a.trajectory.samples[i].q.joints == b.trajectory.samples[i].q.joints &&
+             a.trajectory.samples[i].q.base_position == b.trajectory.samples[i].q.base_position;
+    return same;
+  };
+  if (keep.success() && one_thread.success())
+    std::printf("same trajectory on 1 and 2 threads (n = 20): %s\n", same(keep, one_thread) ? "yes" : "NO");
+  if (one_thread.success() && fixed_order.success())
+    std::printf("repairs in the order a first failure names against their fixed order (n = 20, 1 thread): %.2f times "
+                "the wall time, %.2f times the posture calls, same trajectory: %s\n",
+                one_thread.trajectory.stats.seconds / fixed_order.trajectory.stats.seconds,
+                static_cast<double>(one_thread.trajectory.stats.posture_calls) /
+                    static_cast<double>(fixed_order.trajectory.stats.posture_calls),
+                same(one_thread, fixed_order) ? "yes" : "no (each valid: another repair made a transition first)");
   if (keep.success()) {
     ValidityChecker checker(sc.robot, sc.scene);
     const TrajectoryReport rep = checkTrajectory(keep.trajectory, sc, checker);

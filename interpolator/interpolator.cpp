@@ -101,6 +101,7 @@ TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};
   to.timing.zmp_shift_cap = opt.zmp_shift_cap;
   to.verify_samples = opt.verify_samples;
+  to.order_by_failure = opt.order_by_failure;
   return to;
 }
 

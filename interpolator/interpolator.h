@@ -38,6 +38,10 @@ struct InterpolatorOptions {
   // Last, a jump between two branches of the inverse kinematics bridged by
   // knots from the straight joint-space line across it (transition.h).
   bool bridge_jumps = true;
+  // The repair a transition's first failure names tried next
+  // (TransitionOptions::order_by_failure); off: the fixed order, for
+  // measuring what the order saves (bench_interpolator).
+  bool order_by_failure = true;
   // Check every output sample with the validity contract (and refine where
   // one fails). Off, only knots and segment middles are checked: for
   // measuring what the verification costs, not for output.
@@ -86,7 +90,7 @@ struct InterpolationResult {
   std::vector<int> failed_stances;      // the transition that failed: from, to
   Trajectory trajectory;                // on success
   int filtered = 0;                     // stances dropped
-  int refinements = 0;                  // knots inserted between steps
+  int refinements = 0;                  // knots inserted between steps, over every attempt made
   double posture_seconds = 0;           // of the wall time, inside the posture generator
   // The transitions solved, in the plan's order, up to and with the one that
   // failed (none when the filtering or the design failed first).

@@ -131,8 +131,9 @@ struct TransitionSolver::Attempt {
   double posture_seconds = 0;
   int refinements = 0;
   std::string reason;
-  // The robot links the failing check named, when the attempt failed on a
-  // check (a collision) and not on a posture the generator could not find.
+  // The robot links the failing check named (collisions, contacts), when the
+  // attempt failed on a check and not on a posture the generator could not
+  // find; none when a failing part names no link (equilibrium, joint limits).
   std::vector<int> failed_links;
   // Set when the attempt failed on a segment that no halving shortened (a
   // jump between two branches of the inverse kinematics), which bridges close.
@@ -201,14 +202,19 @@ struct Refiner {
   // not converge (what bridges would have taken on).
   bool* jumped;
 
-  // The failing parts of a report: the last one's first violation, and the links they name.
+  // The failing parts of a report: the last one's first violation, and the
+  // links they name; none if a failing part names none (an equilibrium lost
+  // is not the free limbs' alone, whatever collides with it).
   static void failure(const ValidityReport& r, std::string* why, std::vector<int>* links) {
     links->clear();
+    bool unplaced = false;
     for (const auto& p : r.parts)
       if (p.checked && !p.ok()) {
         *why = p.name + ": " + p.violations[0];
+        unplaced = unplaced || p.links.empty();
         links->insert(links->end(), p.links.begin(), p.links.end());
       }
+    if (unplaced) links->clear();
   }
 
   bool midValid(const Configuration& a, const Configuration& b, std::string* why, std::vector<int>* links) {
@@ -245,7 +251,7 @@ struct Refiner {
         *reason = "between two knots, after " + std::to_string(level) + " refinements" +
                   (bridging ? " (bridged)" : "") + ": " + why;
         *failed_links = std::move(links);
-        *jumped = !bridges && !converging;
+        *jumped = !bridges && level > 0 && !converging;
         return false;
       }
       bridging = true;
@@ -352,7 +358,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
     std::string reasons;
     std::vector<LimbJointPath> limbs;
     bool limbs_planned = false;
-    // Last, the knots as planned with each jump between two branches bridged.
+    // Then the knots as planned with each jump between two branches bridged.
     const char* what[] = {"as planned", "each knot near its neighbour too", "with more clearance",
                           "with more clearance, each knot near its neighbour", "with the free limbs' joints planned",
                           "with the free limbs' joints planned, each knot near its neighbour",
@@ -551,7 +557,8 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
         out.repaired = true;
         out.how = "as planned, with bridges across branch jumps";
       } else if (!at.cancelled) {
-        reasons += (reasons.empty() ? "" : "; ") + std::string("as planned, with bridges across branch jumps: ") + at.reason;
+        reasons += (reasons.empty() ? "" : "; ") + std::string("as planned, with bridges across branch jumps: ") +
+                   at.reason;
       }
       return ok;
     };

@@ -112,15 +112,18 @@ struct TransitionOptions {
   // (limb_path_planner.h) and the knots follow them instead of its end's path.
   bool limb_joint_paths = true;
   double free_limb_weight = 100;
-  // Where the first attempt's failure says which repair it needs, that one
-  // is tried next: the free limbs' stages where the collisions its check
-  // found are all on links of limbs with no contact, before the repairs that
-  // change the moving body's path or the whole body's knots, which do not
-  // move those limbs out of the way; else bridges (bridge_jumps) where a
-  // segment no halving shortened (a jump between two branches of the inverse
-  // kinematics) fails on held contacts alone. Only the order of the attempts changes (each is still made
-  // until one succeeds), so a transition is solved or not alike; off: the
-  // order above.
+  // Where the first attempt's failure says which repair it needs, that
+  // repair's first attempt comes next: the free limbs' (on their own paths,
+  // then their joints planned) where the collisions its check found are all
+  // on links of limbs with no contact, before the repairs that change the
+  // moving body's path or the whole body's knots, which do not move those
+  // limbs out of the way; else bridges (bridge_jumps) where a segment no
+  // halving shortened (a jump between two branches of the inverse
+  // kinematics) fails on held contacts alone. Only the order of the attempts
+  // changes (each is still made until one succeeds), so a transition is
+  // solved or not alike; how it is made can change where an attempt moved
+  // forward succeeds and one it passed would have too (on the shipped plans
+  // it does not; bench_interpolator says). Off: the order above.
   bool order_by_failure = true;
   // A fixed-contact transition whose knots cannot be made valid at the
   // posture generator's collision margin is solved once more with this much
@@ -157,7 +160,7 @@ struct TransitionOutcome {
   bool repaired = false;
   std::string how;                   // when solved: "as planned", or the repair that made it
   int attempts = 0;                  // attempts made (each solves its knots anew)
-  int refinements = 0;               // knots inserted between the n steps
+  int refinements = 0;               // knots inserted between the n steps, over every attempt made
 };
 
 class TransitionSolver {

@@ -127,9 +127,10 @@ int main(int argc, char** argv) {
     if (tty) std::fprintf(stderr, "\n");
     if (verbose)
       for (const acyclic::TransitionRecord& t : r.transitions)
-        std::fprintf(stderr, "acyclic-interpolator: transition %d -> %d (%s): %s; %d attempt%s, %ld posture calls, %.2f s\n",
-                     t.from, t.to, t.move ? "a body moves" : "contacts fixed",
-                     t.ok ? t.how.c_str() : "not made", t.attempts, t.attempts == 1 ? "" : "s", t.posture_calls,
+        std::fprintf(stderr,
+                     "acyclic-interpolator: transition %d -> %d (%s): %s; %d attempt%s, %ld posture call%s, %.2f s\n",
+                     t.from, t.to, t.move ? "a body moves" : "contacts fixed", t.ok ? t.how.c_str() : "not made",
+                     t.attempts, t.attempts == 1 ? "" : "s", t.posture_calls, t.posture_calls == 1 ? "" : "s",
                      t.seconds);
     if (!r.success()) {
       std::printf("acyclic-interpolator: %s: %s: %s\n", in.c_str(), acyclic::toString(r.status), r.reason.c_str());

@@ -1018,6 +1018,54 @@ TEST(ValidityCheck, VerdictsInSequenceFindEveryCollision) {
   EXPECT_GT(colliding, checks / 10);
 }
 
+// A failed check names the robot links its violations are about
+// (CheckPart::links, which the interpolator orders its repairs by): an arm
+// swept down through the table names links of that arm and, for a self pair,
+// the link it hits, each in a violation's text; a base moved 5 mm off every
+// contact names each contact's spot's link, in the stance's order.
+TEST(ValidityCheck, NamesTheLinksOfWhatFailed) {
+  const Scenario& sc = chair();
+  const RobotModel& m = *sc.robot;
+  const Plan plan = readPlan(test::sourcePath("tests/data/chair.plan.json"), sc);
+  ValidityChecker checker(sc.robot, sc.scene);
+  auto part = [](const ValidityReport& r, const std::string& name) {
+    for (const auto& p : r.parts)
+      if (p.name == name) return p;
+    ADD_FAILURE() << "no part " << name;
+    return CheckPart{};
+  };
+  const int arm = m.jointIndex("RARM_JOINT0");
+  int colliding = 0;
+  for (std::size_t i = 0; i < plan.stances.size(); i += 8) {
+    const auto stance = plan.stances[i].specs();
+    for (int n = 0; n <= 24; ++n) {
+      Configuration q = plan.stances[i].configuration;
+      q.joints[arm] -= 0.08 * n;
+      const CheckPart c = part(checker.checkPosture(q, stance), "collisions");
+      EXPECT_EQ(c.ok(), c.links.empty()) << i << " " << n;
+      if (c.ok()) continue;
+      ++colliding;
+      bool on_arm = false;
+      for (int link : c.links) {
+        on_arm = on_arm || m.jointMovesLink(arm, link);
+        bool named = false;
+        for (const auto& v : c.violations) named = named || v.find(m.links()[link].name) != std::string::npos;
+        EXPECT_TRUE(named) << m.links()[link].name << " in none of the violations, stance " << i << " step " << n;
+      }
+      EXPECT_TRUE(on_arm) << i << " " << n;
+    }
+  }
+  EXPECT_GT(colliding, 5);
+  const PlanStance& st = plan.stances.front();
+  Configuration q = st.configuration;
+  q.base_position.x() += 0.005;
+  const CheckPart c = part(checker.checkPosture(q, st.specs()), "contacts");
+  std::vector<int> expected;
+  for (const auto& spec : st.specs()) expected.push_back(m.spots()[spec.spot].link);
+  EXPECT_EQ(c.links, expected);
+  EXPECT_TRUE(part(checker.checkPosture(st.configuration, st.specs()), "contacts").links.empty());
+}
+
 // The checker takes each corner's Jacobian from one frame Jacobian of its
 // contact (J_p = J_v - [p - o]x J_w): the forces it reports, mapped through
 // Simbody's own station Jacobian at each reported corner, balance gravity on
