@@ -224,8 +224,8 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
     const TransitionDesign& d = designs[i];
     if (!done[i] || outcomes[i].cancelled) return fail(Status::Cancelled, "cancelled");
     TransitionOutcome& o = outcomes[i];
-    res.transitions.push_back({d.from, d.to, d.kind == TransitionDesign::Kind::Move, o.ok, o.how, o.attempts,
-                               o.posture_calls, o.seconds});
+    res.transitions.push_back({d.from, d.to, d.kind == TransitionDesign::Kind::Move, o.still, o.ok, o.how,
+                               o.attempts, o.posture_calls, o.seconds});
     if (!o.ok) {
       res.failed_stances = {d.from, d.to};
       const std::string where = "stances " + std::to_string(d.from) + " -> " + std::to_string(d.to) + ": ";

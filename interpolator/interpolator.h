@@ -76,6 +76,7 @@ struct InterpolationProgress {
 struct TransitionRecord {
   int from = 0, to = 0;                 // stance indices
   bool move = false;                    // a body moves (else a fixed-contact transition)
+  bool still = false;                   // a Move whose body already touches: made as a fixed one (`how` from that list)
   bool ok = false;
   std::string how;                      // the attempt that made it (TransitionOutcome::how)
   int attempts = 0;

@@ -345,6 +345,7 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
   // generator an over-determined body).
   const std::optional<TransitionDesign> still = stillBody(plan, d);
   const TransitionDesign& fd = still ? *still : d;
+  out.still = still.has_value();
   if (fd.kind == TransitionDesign::Kind::Fixed) {
     // First the knots nearest the witnesses' interpolation. When it cuts
     // through an obstacle the knots slide along it at the collision margin,

@@ -158,6 +158,7 @@ struct TransitionOutcome {
   double posture_seconds = 0;        // wall time inside the posture generator
   double seconds = 0;                // wall time of the whole solve
   bool repaired = false;
+  bool still = false;                // a Move whose body already touches where it goes: solved as a fixed transition
   std::string how;                   // when solved: "as planned", or the repair that made it
   int attempts = 0;                  // attempts made (each solves its knots anew)
   int refinements = 0;               // knots inserted between the n steps, over every attempt made

@@ -129,7 +129,11 @@ int main(int argc, char** argv) {
       for (const acyclic::TransitionRecord& t : r.transitions)
         std::fprintf(stderr,
                      "acyclic-interpolator: transition %d -> %d (%s): %s; %d attempt%s, %ld posture call%s, %.2f s\n",
-                     t.from, t.to, t.move ? "a body moves" : "contacts fixed", t.ok ? t.how.c_str() : "not made",
+                     t.from, t.to,
+                     t.still  ? "a body already touching where it goes, its contacts fixed"
+                     : t.move ? "a body moves"
+                              : "contacts fixed",
+                     t.ok ? t.how.c_str() : "not made",
                      t.attempts, t.attempts == 1 ? "" : "s", t.posture_calls, t.posture_calls == 1 ? "" : "s",
                      t.seconds);
     if (!r.success()) {

@@ -1379,6 +1379,17 @@ TEST(InterpolatorProcess, VerboseSaysHowEachTransitionWasMadeAndWhatItCost) {
   const auto quiet = test::runProcess(cmd);
   ASSERT_EQ(quiet.status, 0) << quiet.output;
   EXPECT_EQ(quiet.output.find("acyclic-interpolator: transition "), std::string::npos) << quiet.output;
+  // A wrist laid beside the forearm already on the table does not move: it
+  // is said so, made as a fixed-contact transition.
+  const auto still = test::runProcess(interp + " -q -v --no-filter --scenario " +
+                                      test::sourcePath("models/scenarios/chair_table.yaml") + " --in " +
+                                      test::sourcePath("tests/data/chair_ompl_wrist_beside_forearm.plan.json") +
+                                      " --out " + dir.path() + "/still.json");
+  ASSERT_EQ(still.status, 0) << still.output;
+  EXPECT_NE(still.output.find("transition 0 -> 1 (a body already touching where it goes, its contacts fixed): as "
+                              "planned; 1 attempt, "),
+            std::string::npos)
+      << still.output;
 }
 
 TEST(TransitionSolver, AJumpBetweenBranchesIsBridgedOnTheSecondAttempt) {
