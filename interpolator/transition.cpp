@@ -399,9 +399,10 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
         // knots) its bridges.
         if (attempt == 0 && opt_.order_by_failure) {
           std::vector<int> next{0};
-          if (opt_.free_limb_paths && opt_.limb_joint_paths && onFreeLimbsOnly(fd, at.failed_links))
+          const NamedRepair named = namedRepair(fd, at);
+          if (named == NamedRepair::FreeLimbs && opt_.free_limb_paths && opt_.limb_joint_paths)
             next.push_back(kLimbsPlanned);
-          else if (at.jumped && opt_.bridge_jumps && onHeldBodiesOnly(fd, at.failed_links))
+          else if (named == NamedRepair::Bridges)
             next.push_back(kBridges);
           for (int a : order)
             if (std::find(next.begin(), next.end(), a) == next.end()) next.push_back(a);
@@ -564,16 +565,13 @@ TransitionOutcome TransitionSolver::solve(const Plan& plan, const TransitionDesi
       return ok;
     };
     out.ok = tryAttempt(nullptr, "", 0);
-    // What the first failure says it needs, before the rest in their order.
-    const std::vector<int> first_links = at.failed_links;
-    // A jump that fails on the held contacts alone (a held palm pressed into
-    // the table between two knots) is bridged next; one of the moving body (a
-    // foot past a chair's leg, which a detour avoids) or of a free limb is not.
-    if (!out.ok && !at.cancelled && opt_.order_by_failure && opt_.bridge_jumps && at.jumped &&
-        onHeldBodiesOnly(d, first_links))
-      out.ok = tryBridges();
-    const bool free_first = !out.ok && !at.cancelled && free_stages && opt_.order_by_failure &&
-                            onFreeLimbsOnly(d, first_links);
+    // What the first failure says it needs, before the rest in their order: a
+    // jump that fails on the held contacts alone (a held palm pressed into the
+    // table between two knots) is bridged next, one of the moving body (a foot
+    // past a chair's leg, which a detour avoids) is not.
+    const NamedRepair named = out.ok || at.cancelled ? NamedRepair::None : namedRepair(d, at);
+    if (named == NamedRepair::Bridges) out.ok = tryBridges();
+    const bool free_first = named == NamedRepair::FreeLimbs && free_stages;
     if (free_first) {
       if (!freeStage().empty()) out.ok = tryAttempt(&free, free_label, 0);
       if (!out.ok && !at.cancelled && joint_stage && !jointStage().empty())
@@ -873,6 +871,13 @@ bool TransitionSolver::onHeldBodiesOnly(const TransitionDesign& d, const std::ve
     return link != moving && std::any_of(d.motion_contacts.begin(), d.motion_contacts.end(),
                                          [&](const ContactSpec& c) { return m.spots()[c.spot].link == link; });
   });
+}
+
+TransitionSolver::NamedRepair TransitionSolver::namedRepair(const TransitionDesign& d, const Attempt& failed) const {
+  if (!opt_.order_by_failure) return NamedRepair::None;
+  if (onFreeLimbsOnly(d, failed.failed_links)) return NamedRepair::FreeLimbs;
+  if (failed.jumped && opt_.bridge_jumps && onHeldBodiesOnly(d, failed.failed_links)) return NamedRepair::Bridges;
+  return NamedRepair::None;
 }
 
 bool TransitionSolver::onFreeLimbsOnly(const TransitionDesign& d, const std::vector<int>& links) const {

@@ -207,6 +207,13 @@ class TransitionSolver {
   // Whether every one of `links` is a held contact's (d.motion_contacts'),
   // not the moving body's; false for none.
   bool onHeldBodiesOnly(const TransitionDesign& d, const std::vector<int>& links) const;
+  // The repair a failed attempt's check names (TransitionOptions::order_by_failure):
+  // the free limbs' stages where it failed on free limbs alone, else bridges
+  // where it failed on a jump between branches on held contacts alone, else
+  // none. (On HRP-2 the first two exclude each other: its spots hang from the
+  // hips and shoulders, so a held contact's link is on no free limb.)
+  enum class NamedRepair { None, FreeLimbs, Bridges };
+  NamedRepair namedRepair(const TransitionDesign& d, const Attempt& failed) const;
   // A Move whose body already touches its surface in both witnesses, as the
   // Fixed transition that holds it touching; none for any other.
   std::optional<TransitionDesign> stillBody(const Plan& plan, const TransitionDesign& d);

@@ -1325,6 +1325,17 @@ std::pair<TransitionOutcome, TransitionOutcome> solveInBothOrders(const std::str
   }
   return r;
 }
+
+// solveInBothOrders, and the repair the first failure names made it on the
+// second attempt (`how`), the fixed order on its `fixed_attempts`-th.
+std::pair<TransitionOutcome, TransitionOutcome> expectMadeSecond(const std::string& file, const std::string& how,
+                                                                 int fixed_attempts) {
+  auto r = solveInBothOrders(file);
+  EXPECT_EQ(r.first.how, how);
+  EXPECT_EQ(r.first.attempts, 2);
+  EXPECT_EQ(r.second.attempts, fixed_attempts);
+  return r;
+}
 }  // namespace
 
 TEST(TransitionSolver, AStepWhoseFreeHandGrazesTheChairsBackTriesTheFreeLimbsStageSecond) {
@@ -1335,10 +1346,8 @@ TEST(TransitionSolver, AStepWhoseFreeHandGrazesTheChairsBackTriesTheFreeLimbsSta
   // with the free limbs on paths of their own solves it. Free limbs first,
   // that is the second attempt; the body's path first, after its four
   // repairs and OMPL's path for the foot. The same attempt, the same knots.
-  const auto [free_first, body_first] = solveInBothOrders("chair_paper_ompl_step_hand_by_chair_back.plan.json");
-  EXPECT_EQ(free_first.how, "with the free limbs on their own paths, as planned");
-  EXPECT_EQ(free_first.attempts, 2);
-  EXPECT_EQ(body_first.attempts, 7);
+  const auto [free_first, body_first] = expectMadeSecond("chair_paper_ompl_step_hand_by_chair_back.plan.json",
+                                                         "with the free limbs on their own paths, as planned", 7);
   EXPECT_LT(free_first.posture_calls, body_first.posture_calls);
 }
 
@@ -1349,10 +1358,7 @@ TEST(TransitionSolver, AWeightShiftWhoseFreeArmCutsTheTablePlansItsJointsSecond)
   // links). Free limbs first, the arm's joints are planned on the second
   // attempt; whole body first, after the knots near their neighbours and with
   // more clearance (three attempts more). The same attempt, the same knots.
-  const auto [free_first, body_first] = solveInBothOrders("chair_paper_ompl_wrist_unloaded_arm_over_table.plan.json");
-  EXPECT_EQ(free_first.how, "with the free limbs' joints planned");
-  EXPECT_EQ(free_first.attempts, 2);
-  EXPECT_EQ(body_first.attempts, 5);
+  expectMadeSecond("chair_paper_ompl_wrist_unloaded_arm_over_table.plan.json", "with the free limbs' joints planned", 5);
 }
 
 TEST(InterpolatorProcess, VerboseSaysHowEachTransitionWasMadeAndWhatItCost) {
@@ -1399,10 +1405,8 @@ TEST(TransitionSolver, AJumpBetweenBranchesIsBridgedOnTheSecondAttempt) {
   // halving shortens the segment between them (the held palm 1.39 mm into
   // the table in its middle). Bridged, it is made; the fixed order bridges
   // it on its sixth attempt, after the four repairs of the thigh's path.
-  const auto [jump_first, fixed_order] = solveInBothOrders("chair_paper_ompl_palm_held_branch_jump.plan.json");
-  EXPECT_EQ(jump_first.how, "as planned, with bridges across branch jumps");
-  EXPECT_EQ(jump_first.attempts, 2);
-  EXPECT_EQ(fixed_order.attempts, 6);
+  const auto [jump_first, fixed_order] = expectMadeSecond("chair_paper_ompl_palm_held_branch_jump.plan.json",
+                                                          "as planned, with bridges across branch jumps", 6);
   EXPECT_LT(jump_first.posture_calls, fixed_order.posture_calls);
 }
 
@@ -1411,8 +1415,5 @@ TEST(TransitionSolver, AWeightShiftWithAJumpBetweenBranchesIsBridgedOnTheSecondA
   // two branches, the held palm 3 mm off its point between two of them: the
   // same, for a fixed-contact transition (the fixed order bridges it after
   // the knots near their neighbours and the two with more clearance).
-  const auto [jump_first, fixed_order] = solveInBothOrders("chair_paper_ompl_fixed_branch_jump.plan.json");
-  EXPECT_EQ(jump_first.how, "with bridges across branch jumps");
-  EXPECT_EQ(jump_first.attempts, 2);
-  EXPECT_EQ(fixed_order.attempts, 5);
+  expectMadeSecond("chair_paper_ompl_fixed_branch_jump.plan.json", "with bridges across branch jumps", 5);
 }
