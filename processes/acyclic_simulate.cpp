@@ -22,7 +22,9 @@ int main(int argc, char** argv) {
       "Executes a trajectory in a dynamics simulation (Simbody multibody dynamics, not kinematics): the\n"
       "base is free, each joint a PD servo toward the trajectory's q with its dq as feed-forward (gains from\n"
       "the effort limits, torque clamped to them), contacts compliant Hunt-Crossley spheres at the contact\n"
-      "spots' polygon corners against the scene's surfaces with their friction. Prints per phase the base\n"
+      "spots' polygon corners against the scene's surfaces with their friction, and the links' collision\n"
+      "shapes against the surfaces they come near (a contact the plan does not make, reported). Prints per\n"
+      "phase the base\n"
       "drift and tilt against the plan, each contact's slip, lift-off and force against the quasi-static\n"
       "plan's, the worst joint tracking error, and the verdict (executed / fell / slipped, time, reason).\n"
       "Where HRP-2's bridge runs its stabilizer (only coplanar feet touch), a model of it corrects the legs'\n"
@@ -61,10 +63,18 @@ int main(int argc, char** argv) {
                  "stabilizer: a foot rises at (measured - wanted normal force) / this, N s/m (default 2e4)");
   app.add_option("--stabilizer-off-time", o.stabilizer_options.off_time,
                  "stabilizer: switched off, its offsets fade out with this time constant, s (default 0.3)");
+  bool no_body = false;
+  app.add_flag("--no-body-contacts", no_body,
+               "only the contact spots touch the scene: no collision shape of a link meets a surface (as before "
+               "2026-12-07; a seated robot that tips back does not land on its waist)");
+  app.add_option("--body-contact-range", o.body_contact_range,
+                 "a link's collision shapes meet a surface they come within this of somewhere along the trajectory, "
+                 "m (default 0.02)");
   app.add_flag("-q,--quiet", quiet, "print only the verdict");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   o.stabilizer = !open_loop;
+  o.body_contacts = !no_body;
   hrp2::LoadedTrajectory loaded;
   try {
     o.validate();
@@ -149,6 +159,11 @@ int main(int argc, char** argv) {
                   r.stabilizer_on_time, tr.duration(), r.stabilizer_max_tilt * 180 / M_PI, 1e3 * r.stabilizer_max_lift);
     else
       std::printf("stabilizer: none (--no-stabilizer), every phase open-loop\n");
+    if (r.body_contacts.empty())
+      std::printf("unplanned contacts: none%s\n", o.body_contacts ? "" : " modelled (--no-body-contacts)");
+    for (const auto& b : r.body_contacts)
+      std::printf("unplanned contact: %s on %s, from %.3f s, %.2f s in all, up to %.0f N\n", b.link.c_str(),
+                  b.surface.c_str(), b.first_time, b.loaded_time, b.max_force);
     std::printf("time: %.2f s simulated in %.2f s wall (%.2fx real time)\n", r.motion_time, r.wall_time,
                 r.wall_time > 0 ? r.motion_time / r.wall_time : 0.0);
     std::printf("acceptance: %s (no fall, supporting slip < %.0f mm, base within %.0f mm of the plan)\n",

@@ -57,6 +57,37 @@ std::vector<int> floorSurfaces(const Scene& scene) {
   return out;
 }
 
+// A collision shape as contact spheres (centre in its link's frame, radius)
+// that touch a plane where the shape does: a box's corners (spheres of
+// `small` radius, inset so that they touch the box's faces' planes), a
+// capsule's two ends, a sphere, a cylinder's two rims (eight each).
+std::vector<std::pair<Eigen::Vector3d, double>> shapeSpheres(const CollisionShape& sh, double small) {
+  std::vector<std::pair<Eigen::Vector3d, double>> out;
+  switch (sh.kind) {
+    case CollisionShape::Kind::Box: {
+      const Eigen::Vector3d h = (0.5 * sh.size).cwiseMax(Eigen::Vector3d::Constant(small)) - Eigen::Vector3d::Constant(small);
+      for (int i = 0; i < 8; ++i)
+        out.push_back({sh.pose * Eigen::Vector3d((i & 1 ? 1 : -1) * h.x(), (i & 2 ? 1 : -1) * h.y(), (i & 4 ? 1 : -1) * h.z()),
+                       small});
+      break;
+    }
+    case CollisionShape::Kind::Capsule:
+      for (double z : {-0.5 * sh.length, 0.5 * sh.length}) out.push_back({sh.pose * Eigen::Vector3d(0, 0, z), sh.radius});
+      break;
+    case CollisionShape::Kind::Sphere:
+      out.push_back({sh.pose.translation(), sh.radius});
+      break;
+    case CollisionShape::Kind::Cylinder: {
+      const double r = std::max(sh.radius - small, 0.0), z = std::max(0.5 * sh.length - small, 0.0);
+      for (double zz : {-z, z})
+        for (int k = 0; k < 8; ++k)
+          out.push_back({sh.pose * Eigen::Vector3d(r * std::cos(k * M_PI / 4), r * std::sin(k * M_PI / 4), zz), small});
+      break;
+    }
+  }
+  return out;
+}
+
 // How deep below a surface a sphere still touches it: deeper than a
 // sphere's compression under any load here, shallower than the obstacles.
 constexpr double kSlab = 0.02;  // m
@@ -116,6 +147,8 @@ void DynamicsOptions::validate() const {
   if (integrator != "rk-merson" && integrator != "rk3" && integrator != "semi-explicit-euler2" && integrator != "cpodes")
     throw std::invalid_argument("integrator must be cpodes, semi-explicit-euler2, rk-merson or rk3 (got " + integrator + ")");
   if (!(settle >= 0)) throw std::invalid_argument("settle must be >= 0");
+  if (!(body_contact_range >= 0) || !std::isfinite(body_contact_range))
+    throw std::invalid_argument("body_contact_range must be >= 0 (got " + std::to_string(body_contact_range) + ")");
   stabilizer_options.validate();
 }
 
@@ -135,6 +168,44 @@ std::vector<std::pair<int, int>> contactPairs(const Trajectory& tr) {
   return {s.begin(), s.end()};
 }
 
+std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Trajectory& tr, double range) {
+  const RobotModel& m = *sc.robot;
+  const auto& surfaces = sc.scene->surfaces();
+  // The surfaces each link's spots meet: modelled by the spots.
+  std::set<std::pair<int, int>> spotted;
+  for (const auto& [sp, sf] : contactPairs(tr)) spotted.insert({m.spots()[sp].link, sf});
+  for (int f : floorSurfaces(*sc.scene))
+    for (const ContactSpot& spot : m.spots()) spotted.insert({spot.link, f});
+  std::vector<std::vector<std::pair<Eigen::Vector3d, double>>> spheres(m.numLinks());
+  for (int l = 0; l < m.numLinks(); ++l)
+    for (const CollisionShape& sh : m.links()[l].shapes)
+      for (const auto& sp : shapeSpheres(sh, DynamicsOptions{}.sphere_radius)) spheres[l].push_back(sp);
+  std::set<std::pair<int, int>> found;
+  Kinematics kin(sc.robot);
+  const int n = static_cast<int>(tr.samples.size());
+  for (int k = 0; k < n; ++k) {
+    const bool phase_start = k > 0 && tr.samples[k].phase != tr.samples[k - 1].phase;
+    if (k % 10 != 0 && k != n - 1 && !phase_start) continue;
+    kin.setConfiguration(tr.samples[k].q);
+    for (int l = 0; l < m.numLinks(); ++l) {
+      if (spheres[l].empty()) continue;
+      const Eigen::Isometry3d X = kin.linkPose(l);
+      for (int sf = 0; sf < static_cast<int>(surfaces.size()); ++sf) {
+        if (spotted.count({l, sf}) || found.count({l, sf})) continue;
+        const Eigen::Isometry3d to_surface = surfaces[sf].frame.inverse();
+        for (const auto& [c, r] : spheres[l]) {
+          const Eigen::Vector3d p = to_surface * (X * c);
+          if (p.z() - r < range && p.z() > -kSlab && surfaces[sf].polygon.contains(p.head<2>())) {
+            found.insert({l, sf});
+            break;
+          }
+        }
+      }
+    }
+  }
+  return {found.begin(), found.end()};
+}
+
 // ---------------------------------------------------------------------------
 
 // The servo's reference: linear in time from (t0, q0, dq0) to (t1, q1, dq1),
@@ -152,6 +223,7 @@ struct Reference {
 
 struct Sphere {
   int spot = -1, surface = -1;
+  int body = -1;  // a body sphere (spot -1): its index in the body pairs
 };
 
 struct DynamicsSimulator::Impl {
@@ -195,9 +267,11 @@ struct DynamicsSimulator::Impl {
     const Impl& s_;
   };
 
+  int body_pairs = 0;
+
   Impl(const Scenario& sc, const Configuration& start, const DynamicsOptions& o,
-       const std::vector<std::pair<int, int>>& pairs)
-      : robot(sc.robot), scene(sc.scene), opt(o) {
+       const std::vector<std::pair<int, int>>& pairs, const std::vector<std::pair<int, int>>& bodies)
+      : robot(sc.robot), scene(sc.scene), opt(o), body_pairs(static_cast<int>(bodies.size())) {
     opt.validate();
     const RobotModel& m = *robot;
     const int n = m.numJoints();
@@ -270,6 +344,21 @@ struct DynamicsSimulator::Impl {
         spheres.push_back({sp, sf});
       }
     }
+    // The body's shapes on the surfaces they come near (bodyContactPairs).
+    for (int b = 0; b < body_pairs; ++b) {
+      const auto [link, sf] = bodies[b];
+      for (const CollisionShape& sh : m.links().at(link).shapes)
+        for (const auto& [centre, radius] : shapeSpheres(sh, opt.sphere_radius)) {
+          SimTK::ContactSurface cs(SimTK::ContactGeometry::Sphere(radius), material(surfaces.at(sf).friction));
+          cs.joinClique(robot_clique);
+          for (std::size_t s = 0; s < surfaces.size(); ++s)
+            if (static_cast<int>(s) != sf) cs.joinClique(clique[s]);
+          SimTK::Body& body = matter.updMobilizedBody(link_mobod[link]).updBody();
+          const int on_body = body.addContactSurface(SimTK::Transform(toSimVec(centre)), cs);
+          sphere_bodies.push_back({static_cast<int>(sphere_bodies.size()), {link_mobod[link], on_body}});
+          spheres.push_back({-1, sf, b});
+        }
+    }
     system.realizeTopology();
     for (const auto& [k, mb] : sphere_bodies)
       sphere_of_surface[static_cast<int>(tracker.getContactSurfaceIndex(mb.first, mb.second))] = spheres[k];
@@ -339,23 +428,17 @@ struct DynamicsSimulator::Impl {
     return toEigen(matter.getMobilizedBody(link_mobod[s.link]).getBodyTransform(current())) * s.frame;
   }
 
-  // Per spot: the contact force and its moment about the spot's origin (world).
-  std::vector<SpotWrench> spotWrenches() const {
+  // Calls f(sphere, force on the robot, its moment about the contact point,
+  // the contact point; world) for each active contact on a robot sphere.
+  template <class F>
+  void forEachSphereForce(F&& f) const {
     const SimTK::State& st = current();
     system.realize(st, SimTK::Stage::Dynamics);
-    std::vector<SpotWrench> out(robot->spots().size());
-    std::vector<Eigen::Vector3d> origin(robot->spots().size());
-    for (std::size_t s = 0; s < origin.size(); ++s) {
-      out[s].frame = spotPose(static_cast<int>(s));
-      origin[s] = out[s].frame->translation();
-    }
     const SimTK::ContactSnapshot& snap = tracker.getActiveContacts(st);
     for (int i = 0; i < contact.getNumContactForces(st); ++i) {
-      const SimTK::ContactForce& f = contact.getContactForce(st, i);
-      if (!snap.hasContact(f.getContactId())) continue;
-      const SimTK::Contact& c = snap.getContactById(f.getContactId());
-      const Eigen::Vector3d on2 = toEigen(f.getForceOnSurface2()[1]), m2 = toEigen(f.getForceOnSurface2()[0]);
-      const Eigen::Vector3d at = toEigen(f.getContactPoint());
+      const SimTK::ContactForce& cf = contact.getContactForce(st, i);
+      if (!snap.hasContact(cf.getContactId())) continue;
+      const SimTK::Contact& c = snap.getContactById(cf.getContactId());
       double sign = 1;
       auto it = sphere_of_surface.find(static_cast<int>(c.getSurface2()));
       if (it == sphere_of_surface.end()) {
@@ -363,10 +446,34 @@ struct DynamicsSimulator::Impl {
         sign = -1;
       }
       if (it == sphere_of_surface.end()) continue;
-      SpotWrench& w = out[it->second.spot];
-      w.force += sign * on2;
-      w.moment += sign * (m2 + (at - origin[it->second.spot]).cross(on2));
+      f(it->second, sign * toEigen(cf.getForceOnSurface2()[1]), sign * toEigen(cf.getForceOnSurface2()[0]),
+        toEigen(cf.getContactPoint()));
     }
+  }
+
+  // Per spot: the contact force and its moment about the spot's origin (world).
+  std::vector<SpotWrench> spotWrenches() const {
+    std::vector<SpotWrench> out(robot->spots().size());
+    std::vector<Eigen::Vector3d> origin(robot->spots().size());
+    for (std::size_t s = 0; s < origin.size(); ++s) {
+      out[s].frame = spotPose(static_cast<int>(s));
+      origin[s] = out[s].frame->translation();
+    }
+    forEachSphereForce([&](const Sphere& sp, const Eigen::Vector3d& force, const Eigen::Vector3d& moment,
+                           const Eigen::Vector3d& at) {
+      if (sp.spot < 0) return;
+      out[sp.spot].force += force;
+      out[sp.spot].moment += moment + (at - origin[sp.spot]).cross(force);
+    });
+    return out;
+  }
+
+  // Per body pair: the contact force on its shapes (world).
+  std::vector<Eigen::Vector3d> bodyForces() const {
+    std::vector<Eigen::Vector3d> out(body_pairs, Eigen::Vector3d::Zero());
+    forEachSphereForce([&](const Sphere& sp, const Eigen::Vector3d& force, const Eigen::Vector3d&, const Eigen::Vector3d&) {
+      if (sp.body >= 0) out[sp.body] += force;
+    });
     return out;
   }
 
@@ -387,8 +494,9 @@ struct DynamicsSimulator::Impl {
 };
 
 DynamicsSimulator::DynamicsSimulator(const Scenario& sc, const Configuration& start, const DynamicsOptions& options,
-                                     const std::vector<std::pair<int, int>>& pairs)
-    : impl_(std::make_unique<Impl>(sc, start, options, pairs)) {}
+                                     const std::vector<std::pair<int, int>>& pairs,
+                                     const std::vector<std::pair<int, int>>& body_pairs)
+    : impl_(std::make_unique<Impl>(sc, start, options, pairs, body_pairs)) {}
 DynamicsSimulator::~DynamicsSimulator() = default;
 
 void DynamicsSimulator::setReference(const Eigen::VectorXd& q, const Eigen::VectorXd& dq, double ramp) {
@@ -414,6 +522,7 @@ Eigen::Vector3d DynamicsSimulator::centerOfMass() const {
 }
 std::vector<Eigen::Vector3d> DynamicsSimulator::spotForces() const { return impl_->spotForces(); }
 std::vector<SpotWrench> DynamicsSimulator::spotWrenches() const { return impl_->spotWrenches(); }
+std::vector<Eigen::Vector3d> DynamicsSimulator::bodyForces() const { return impl_->bodyForces(); }
 long DynamicsSimulator::steps() const { return impl_->integ->getNumStepsTaken(); }
 
 // ---------------------------------------------------------------------------
@@ -423,7 +532,9 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
   if (tr.samples.empty() || tr.phases.empty()) throw std::invalid_argument("the trajectory has no samples or no phases");
   const auto wall0 = std::chrono::steady_clock::now();
   const RobotModel& m = *sc.robot;
-  DynamicsSimulator sim(sc, tr.samples.front().q, options, contactPairs(tr));
+  const std::vector<std::pair<int, int>> body_pairs =
+      options.body_contacts ? bodyContactPairs(sc, tr, options.body_contact_range) : std::vector<std::pair<int, int>>{};
+  DynamicsSimulator sim(sc, tr.samples.front().q, options, contactPairs(tr), body_pairs);
   DynamicsSimulator::Impl& S = sim.impl();
   SimulationReport rep;
   rep.options = options;
@@ -488,6 +599,7 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
   std::vector<SpotWrench> wrenches = S.spotWrenches();
   Eigen::Vector3d com = sim.centerOfMass();
 
+  std::vector<double> body_first(body_pairs.size(), -1), body_max(body_pairs.size(), 0), body_loaded(body_pairs.size(), 0);
   bool fell = false;
   double last_progress = -1;
   for (int k = 1; k < N + settle_steps && !fell; ++k) {
@@ -524,6 +636,17 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
     for (int j = 0; j < m.numJoints(); ++j) {
       const double e = std::abs(q.joints[j] - to.q.joints[j]);
       if (e > po.tracking) po.tracking = e, po.tracking_joint = m.joints()[j].name;
+    }
+    // Contacts the plan does not make.
+    if (!body_pairs.empty()) {
+      const std::vector<Eigen::Vector3d> bf = sim.bodyForces();
+      for (std::size_t b = 0; b < bf.size(); ++b) {
+        const double fb = bf[b].norm();
+        if (fb < 1e-9) continue;
+        if (body_first[b] < 0) body_first[b] = t1;
+        body_max[b] = std::max(body_max[b], fb);
+        body_loaded[b] += dt;
+      }
     }
     // Contacts.
     const auto& contacts = tr.phases[phase].contacts;
@@ -629,6 +752,12 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
       if (c.supporting && c.slip > rep.worst_slip)
         rep.worst_slip = c.slip, rep.worst_slip_contact = c.spot + "@" + c.surface + " (phase " + std::to_string(p.phase) + ")";
   }
+  for (std::size_t b = 0; b < body_pairs.size(); ++b)
+    if (body_first[b] >= 0)
+      rep.body_contacts.push_back({m.links()[body_pairs[b].first].name, surfaces[body_pairs[b].second].name,
+                                   body_max[b], body_first[b], body_loaded[b]});
+  std::stable_sort(rep.body_contacts.begin(), rep.body_contacts.end(),
+                   [](const BodyContactOutcome& a, const BodyContactOutcome& b) { return a.first_time < b.first_time; });
   rep.base_within_bound = rep.worst_base_drift <= options.base_bound;
   rep.integrator_steps = sim.steps();
   rep.mean_step = rep.integrator_steps > 0 ? rep.motion_time / rep.integrator_steps : 0;
@@ -672,8 +801,14 @@ std::string reportToJson(const SimulationReport& r) {
                   {"sphere_radius", r.options.sphere_radius}, {"stiffness", r.options.stiffness},
                   {"dissipation", r.options.dissipation}, {"transition_velocity", r.options.transition_velocity},
                   {"settle", r.options.settle}, {"slip_bound", r.options.slip_bound},
+                  {"body_contacts", r.options.body_contacts}, {"body_contact_range", r.options.body_contact_range},
                   {"fall_height", r.options.fall_height}, {"fall_tilt", r.options.fall_tilt},
                   {"base_bound", r.options.base_bound}};
+  json bodies = json::array();
+  for (const auto& b : r.body_contacts)
+    bodies.push_back({{"link", b.link}, {"surface", b.surface}, {"max_force", b.max_force},
+                      {"first_time", b.first_time}, {"loaded_time", b.loaded_time}});
+  j["body_contacts"] = bodies;
   json phases = json::array();
   for (const auto& p : r.phases) {
     json jp = {{"phase", p.phase}, {"t_start", p.t_start}, {"t_end", p.t_end}, {"base_drift", p.base_drift},

@@ -59,6 +59,14 @@ struct DynamicsOptions {
   // references are played open-loop elsewhere, and everywhere when false.
   bool stabilizer = true;
   FeetStabilizerOptions stabilizer_options;
+  // The robot's body meets the scene, not only its contact spots: each
+  // link's collision shapes (box corners, capsule ends) against the surfaces
+  // they come within body_contact_range of somewhere along the trajectory,
+  // but those its own spots meet (modelled by the spots, as planned). A
+  // seated robot that tips back lands on its waist as the real one does
+  // (the planner's thigh patches end 6 cm short of the hip).
+  bool body_contacts = true;
+  double body_contact_range = 0.02;  // m
   // After the last sample the final reference is held this long.
   double settle = 0.5;               // s
   // Verdict thresholds.
@@ -80,6 +88,14 @@ struct ContactOutcome {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();       // N, world, simulated, at the phase's middle sample
   Eigen::Vector3d plan_force = Eigen::Vector3d::Zero();  // N, world, quasi-static LP at the same sample
   bool plan_force_known = false;     // the LP found forces there
+};
+
+// A contact the plan does not make: a link's collision shape on a surface.
+struct BodyContactOutcome {
+  std::string link, surface;
+  double max_force = 0;              // N, the largest force it carried
+  double first_time = 0;             // s, when it first carried any
+  double loaded_time = 0;            // s, how long it carried any
 };
 
 struct PhaseOutcome {
@@ -112,6 +128,7 @@ struct SimulationReport {
   double stabilizer_on_time = 0;     // s of the trajectory with the stabilizer on
   double stabilizer_max_tilt = 0;    // rad, a foot's largest turn
   double stabilizer_max_lift = 0;    // m, a foot's largest rise (or fall)
+  std::vector<BodyContactOutcome> body_contacts;  // those that carried force, by first time
   DynamicsOptions options;
   bool executed() const { return verdict == Verdict::Executed; }
 };
@@ -159,9 +176,12 @@ struct JointSample {
 
 class DynamicsSimulator {
  public:
-  // `pairs`: (spot, surface) the spots may touch besides the floor.
+  // `pairs`: (spot, surface) the spots may touch besides the floor;
+  // `body_pairs`: (link, surface) whose collision shapes may touch it
+  // (bodyContactPairs).
   DynamicsSimulator(const Scenario& sc, const Configuration& start, const DynamicsOptions& options,
-                    const std::vector<std::pair<int, int>>& pairs = {});
+                    const std::vector<std::pair<int, int>>& pairs = {},
+                    const std::vector<std::pair<int, int>>& body_pairs = {});
   ~DynamicsSimulator();
   DynamicsSimulator(const DynamicsSimulator&) = delete;
   DynamicsSimulator& operator=(const DynamicsSimulator&) = delete;
@@ -178,6 +198,8 @@ class DynamicsSimulator {
   std::vector<Eigen::Vector3d> spotForces() const;
   // The same with their moment about each spot's origin (world).
   std::vector<SpotWrench> spotWrenches() const;
+  // Sum of the contact forces on each of the body pairs given (world).
+  std::vector<Eigen::Vector3d> bodyForces() const;
   long steps() const;
 
   struct Impl;
@@ -189,5 +211,12 @@ class DynamicsSimulator {
 
 // The spot-surface pairs a trajectory's phases name (deduplicated).
 std::vector<std::pair<int, int>> contactPairs(const Trajectory& tr);
+
+// The link-surface pairs whose collision shapes (as contact spheres: box
+// corners, capsule ends) come within `range` m of the surface, over its
+// polygon, at some sample of the trajectory (every tenth, and each phase's
+// first), leaving out a link whose spots meet that surface (the pairs of
+// contactPairs, and every spot the floor).
+std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Trajectory& tr, double range);
 
 }  // namespace acyclic::hrp2
