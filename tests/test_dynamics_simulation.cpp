@@ -34,6 +34,24 @@ const Scenario& floorScenario() {
   return sc;
 }
 
+// The scenario's start posture and stance held for n samples at 200 Hz.
+Trajectory startHeld(const Scenario& sc, int n) {
+  Trajectory tr;
+  tr.dt = 0.005;
+  TrajectoryPhase ph;
+  ph.contacts = sc.start_stance;
+  ph.t_end = n * tr.dt;
+  tr.phases.push_back(ph);
+  for (int k = 0; k <= n; ++k) {
+    TrajectorySample x;
+    x.t = k * tr.dt;
+    x.q = sc.start;
+    x.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
+    tr.samples.push_back(x);
+  }
+  return tr;
+}
+
 // Standing on both feet, the whole body leaning forward about the ankles by
 // `lean` rad (reached linearly over 1 s, then held for 1 s): the base turns
 // about the ankles' midpoint and the ankle pitch joints turn back, so the
@@ -44,27 +62,17 @@ Trajectory leaningTrajectory(const Scenario& sc, double lean) {
   kin.setConfiguration(sc.start);
   const int r_ankle = m.jointIndex("RLEG_JOINT4"), l_ankle = m.jointIndex("LLEG_JOINT4");
   const Eigen::Vector3d pivot = 0.5 * (kin.jointOrigin(r_ankle) + kin.jointOrigin(l_ankle));
-  Trajectory tr;
-  tr.dt = 0.005;
-  TrajectoryPhase ph;
-  ph.contacts = sc.start_stance;
-  const int n = 400;
-  ph.t_end = n * tr.dt;
-  tr.phases.push_back(ph);
-  for (int k = 0; k <= n; ++k) {
+  Trajectory tr = startHeld(sc, 400);
+  for (int k = 0; k < static_cast<int>(tr.samples.size()); ++k) {
     const double s = std::min(1.0, k / 200.0), a = lean * s;
     const double rate = k < 200 ? lean / 1.0 : 0.0;
     const Eigen::AngleAxisd R(a, Eigen::Vector3d::UnitY());
-    TrajectorySample x;
-    x.t = k * tr.dt;
-    x.q = sc.start;
+    TrajectorySample& x = tr.samples[k];
     x.q.base_position = pivot + R * (sc.start.base_position - pivot);
     x.q.base_orientation = Eigen::Quaterniond(R) * sc.start.base_orientation;
     x.q.joints[r_ankle] -= a;
     x.q.joints[l_ankle] -= a;
-    x.dq = Eigen::VectorXd::Zero(m.numJoints());
     x.dq[r_ankle] = x.dq[l_ankle] = -rate;
-    tr.samples.push_back(x);
   }
   return tr;
 }
@@ -170,20 +178,7 @@ TEST(DynamicsSimulation, ASupportingContactThatNeverTouchesIsReportedAsSuch) {
 // between the waist and the thighs, seated, as the robot itself would.
 TEST(DynamicsSimulation, ASeatedRobotThatTipsBackSitsOnItsWaist) {
   static const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
-  Trajectory tr;
-  tr.dt = 0.005;
-  TrajectoryPhase ph;
-  ph.contacts = sc.start_stance;
-  const int n = 600;
-  ph.t_end = n * tr.dt;
-  tr.phases.push_back(ph);
-  for (int k = 0; k <= n; ++k) {
-    TrajectorySample x;
-    x.t = k * tr.dt;
-    x.q = sc.start;
-    x.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
-    tr.samples.push_back(x);
-  }
+  const Trajectory tr = startHeld(sc, 600);
   hrp2::DynamicsOptions o;
   o.settle = 0;
   o.body_contacts = false;
