@@ -168,7 +168,9 @@ std::vector<std::pair<int, int>> contactPairs(const Trajectory& tr) {
   return {s.begin(), s.end()};
 }
 
-std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Trajectory& tr, double range) {
+std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Trajectory& tr,
+                                                  const DynamicsOptions& options) {
+  const double range = options.body_contact_range;
   const RobotModel& m = *sc.robot;
   const auto& surfaces = sc.scene->surfaces();
   // The surfaces each link's spots meet: modelled by the spots.
@@ -179,7 +181,7 @@ std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Traj
   std::vector<std::vector<std::pair<Eigen::Vector3d, double>>> spheres(m.numLinks());
   for (int l = 0; l < m.numLinks(); ++l)
     for (const CollisionShape& sh : m.links()[l].shapes)
-      for (const auto& sp : shapeSpheres(sh, DynamicsOptions{}.sphere_radius)) spheres[l].push_back(sp);
+      for (const auto& sp : shapeSpheres(sh, options.sphere_radius)) spheres[l].push_back(sp);
   std::set<std::pair<int, int>> found;
   Kinematics kin(sc.robot);
   const int n = static_cast<int>(tr.samples.size());
@@ -533,7 +535,7 @@ SimulationReport simulate(const Scenario& sc, const Trajectory& tr, const Dynami
   const auto wall0 = std::chrono::steady_clock::now();
   const RobotModel& m = *sc.robot;
   const std::vector<std::pair<int, int>> body_pairs =
-      options.body_contacts ? bodyContactPairs(sc, tr, options.body_contact_range) : std::vector<std::pair<int, int>>{};
+      options.body_contacts ? bodyContactPairs(sc, tr, options) : std::vector<std::pair<int, int>>{};
   DynamicsSimulator sim(sc, tr.samples.front().q, options, contactPairs(tr), body_pairs);
   DynamicsSimulator::Impl& S = sim.impl();
   SimulationReport rep;

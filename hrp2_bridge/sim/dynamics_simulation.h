@@ -212,11 +212,13 @@ class DynamicsSimulator {
 // The spot-surface pairs a trajectory's phases name (deduplicated).
 std::vector<std::pair<int, int>> contactPairs(const Trajectory& tr);
 
-// The link-surface pairs whose collision shapes (as contact spheres: box
-// corners, capsule ends) come within `range` m of the surface, over its
-// polygon, at some sample of the trajectory (every tenth, and each phase's
-// first), leaving out a link whose spots meet that surface (the pairs of
-// contactPairs, and every spot the floor).
-std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Trajectory& tr, double range);
+// The link-surface pairs whose collision shapes (as the simulation's
+// contact spheres: box corners of options.sphere_radius, capsule ends) come
+// within options.body_contact_range of the surface, a sphere's centre over
+// its polygon, at some sample of the trajectory (every tenth, each phase's
+// first and the last), leaving out a link whose spots meet that surface
+// (the pairs of contactPairs, and every spot the floor).
+std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Trajectory& tr,
+                                                  const DynamicsOptions& options);
 
 }  // namespace acyclic::hrp2
