@@ -59,29 +59,37 @@ std::vector<int> floorSurfaces(const Scene& scene) {
 
 // A collision shape as contact spheres (centre in its link's frame, radius)
 // that touch a plane where the shape does: a box's corners (spheres of
-// `small` radius, inset so that they touch the box's faces' planes), a
-// capsule's two ends, a sphere, a cylinder's two rims (eight each).
+// `small` radius, or the box's half thickness where it is thinner, inset so
+// that they touch the box's faces' planes), a capsule's two ends, a sphere,
+// a cylinder's two rims (eight each, one where the cylinder is thinner than
+// the spheres). Coincident centres are made once.
 std::vector<std::pair<Eigen::Vector3d, double>> shapeSpheres(const CollisionShape& sh, double small) {
   std::vector<std::pair<Eigen::Vector3d, double>> out;
+  auto add = [&out](const Eigen::Vector3d& c, double r) {
+    for (const auto& [o, ro] : out)
+      if ((o - c).norm() < 1e-12 && ro == r) return;
+    out.push_back({c, r});
+  };
   switch (sh.kind) {
     case CollisionShape::Kind::Box: {
-      const Eigen::Vector3d h = (0.5 * sh.size).cwiseMax(Eigen::Vector3d::Constant(small)) - Eigen::Vector3d::Constant(small);
+      const double r = std::min(small, 0.5 * sh.size.minCoeff());
+      const Eigen::Vector3d h = 0.5 * sh.size - Eigen::Vector3d::Constant(r);
       for (int i = 0; i < 8; ++i)
-        out.push_back({sh.pose * Eigen::Vector3d((i & 1 ? 1 : -1) * h.x(), (i & 2 ? 1 : -1) * h.y(), (i & 4 ? 1 : -1) * h.z()),
-                       small});
+        add(sh.pose * Eigen::Vector3d((i & 1 ? 1 : -1) * h.x(), (i & 2 ? 1 : -1) * h.y(), (i & 4 ? 1 : -1) * h.z()), r);
       break;
     }
     case CollisionShape::Kind::Capsule:
-      for (double z : {-0.5 * sh.length, 0.5 * sh.length}) out.push_back({sh.pose * Eigen::Vector3d(0, 0, z), sh.radius});
+      for (double z : {-0.5 * sh.length, 0.5 * sh.length}) add(sh.pose * Eigen::Vector3d(0, 0, z), sh.radius);
       break;
     case CollisionShape::Kind::Sphere:
-      out.push_back({sh.pose.translation(), sh.radius});
+      add(sh.pose.translation(), sh.radius);
       break;
     case CollisionShape::Kind::Cylinder: {
-      const double r = std::max(sh.radius - small, 0.0), z = std::max(0.5 * sh.length - small, 0.0);
+      const double r = std::min({small, sh.radius, 0.5 * sh.length});
+      const double rim = sh.radius - r, z = 0.5 * sh.length - r;
       for (double zz : {-z, z})
         for (int k = 0; k < 8; ++k)
-          out.push_back({sh.pose * Eigen::Vector3d(r * std::cos(k * M_PI / 4), r * std::sin(k * M_PI / 4), zz), small});
+          add(sh.pose * Eigen::Vector3d(rim * std::cos(k * M_PI / 4), rim * std::sin(k * M_PI / 4), zz), r);
       break;
     }
   }
@@ -97,7 +105,11 @@ constexpr double kSlab = 0.02;  // m
 // the Hunt-Crossley generator applies) for a scene surface, a plane bounded
 // by its polygon and by a slab below it. A sphere whose centre projects
 // outside the polygon, or lies deeper than the slab, does not touch it (a
-// foot beside the chair's seat, a hand under the table).
+// foot beside the chair's seat, a hand under the table). A sphere larger
+// than the spots' (a capsule's end, body contacts) touches only while it is
+// at most the slab plus a spot sphere's radius deep: its centre may be above
+// the plane while most of it is inside the obstacle (a shank under the
+// seat's front edge), which is no contact with the surface's face.
 class SurfaceSphereTracker : public SimTK::ContactTracker::HalfSpaceSphere {
  public:
   struct Face {
@@ -105,14 +117,16 @@ class SurfaceSphereTracker : public SimTK::ContactTracker::HalfSpaceSphere {
     Eigen::Isometry3d world_to_surface;
     ConvexPolygon polygon;
   };
-  explicit SurfaceSphereTracker(std::vector<Face> faces, double slab) : faces_(std::move(faces)), slab_(slab) {}
+  SurfaceSphereTracker(std::vector<Face> faces, double slab, double small)
+      : faces_(std::move(faces)), slab_(slab), small_(small) {}
   bool trackContact(const SimTK::Contact& prior, const SimTK::Transform& X_GH, const SimTK::ContactGeometry& half,
                     const SimTK::Transform& X_GS, const SimTK::ContactGeometry& sphere, SimTK::Real cutoff,
                     SimTK::Contact& current) const override {
     for (const Face& f : faces_) {
       if ((f.X_GH.p() - X_GH.p()).norm() > 1e-9 || (f.X_GH.R().asMat33() - X_GH.R().asMat33()).norm() > 1e-9) continue;
       const Eigen::Vector3d c = f.world_to_surface * toEigen(X_GS.p());
-      if (!f.polygon.contains(c.head<2>()) || c.z() < -slab_) {
+      const double r = SimTK::ContactGeometry::Sphere::getAs(sphere).getRadius();
+      if (!f.polygon.contains(c.head<2>()) || c.z() < -slab_ || (r > small_ && r - c.z() > slab_ + small_)) {
         current.clear();
         return true;
       }
@@ -123,7 +137,7 @@ class SurfaceSphereTracker : public SimTK::ContactTracker::HalfSpaceSphere {
 
  private:
   std::vector<Face> faces_;
-  double slab_;
+  double slab_, small_;
 };
 
 }  // namespace
@@ -326,7 +340,7 @@ struct DynamicsSimulator::Impl {
       matter.updGround().updBody().addContactSurface(X_GH, cs);
       faces.push_back({X_GH, surfaces[s].frame.inverse(), surfaces[s].polygon});
     }
-    tracker.adoptContactTracker(new SurfaceSphereTracker(faces, kSlab));
+    tracker.adoptContactTracker(new SurfaceSphereTracker(faces, kSlab, opt.sphere_radius));
     std::set<std::pair<int, int>> all(pairs.begin(), pairs.end());
     for (int f : floorSurfaces(*scene))
       for (int sp = 0; sp < static_cast<int>(m.spots().size()); ++sp) all.insert({sp, f});
@@ -455,6 +469,7 @@ struct DynamicsSimulator::Impl {
 
   // Per spot: the contact force and its moment about the spot's origin (world).
   std::vector<SpotWrench> spotWrenches() const {
+    system.realize(current(), SimTK::Stage::Position);  // the spots' frames
     std::vector<SpotWrench> out(robot->spots().size());
     std::vector<Eigen::Vector3d> origin(robot->spots().size());
     for (std::size_t s = 0; s < origin.size(); ++s) {

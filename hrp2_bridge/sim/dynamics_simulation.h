@@ -61,10 +61,12 @@ struct DynamicsOptions {
   FeetStabilizerOptions stabilizer_options;
   // The robot's body meets the scene, not only its contact spots: each
   // link's collision shapes (box corners, capsule ends) against the surfaces
-  // they come within body_contact_range of somewhere along the trajectory,
-  // but those its own spots meet (modelled by the spots, as planned). A
+  // the plan brings them within body_contact_range of (bodyContactPairs),
+  // but those its own spots meet (modelled by the spots, as planned).
+  // Elsewhere the body still passes through surfaces and obstacles. A
   // seated robot that tips back lands on its waist as the real one does
-  // (the planner's thigh patches end 6 cm short of the hip).
+  // (the planner's thigh patches end 6 cm short of the hip). Their forces
+  // are not in spotWrenches: the stabilizer's sensors do not see them.
   bool body_contacts = true;
   double body_contact_range = 0.02;  // m
   // After the last sample the final reference is held this long.
