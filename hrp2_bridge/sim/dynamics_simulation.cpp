@@ -57,6 +57,16 @@ std::vector<int> floorSurfaces(const Scene& scene) {
   return out;
 }
 
+// The spot-surface pairs the simulation gives spheres: those given (the
+// trajectory's, contactPairs) and every spot on the floor.
+std::set<std::pair<int, int>> spotSurfaces(const Scene& scene, const RobotModel& m,
+                                           const std::vector<std::pair<int, int>>& pairs) {
+  std::set<std::pair<int, int>> all(pairs.begin(), pairs.end());
+  for (int f : floorSurfaces(scene))
+    for (int sp = 0; sp < static_cast<int>(m.spots().size()); ++sp) all.insert({sp, f});
+  return all;
+}
+
 // A collision shape as contact spheres (centre in its link's frame, radius)
 // that touch a plane where the shape does: a box's corners (spheres of
 // `small` radius, or the box's half thickness where it is thinner, inset so
@@ -189,9 +199,9 @@ std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Traj
   const auto& surfaces = sc.scene->surfaces();
   // The surfaces each link's spots meet: modelled by the spots.
   std::set<std::pair<int, int>> spotted;
-  for (const auto& [sp, sf] : contactPairs(tr)) spotted.insert({m.spots()[sp].link, sf});
-  for (int f : floorSurfaces(*sc.scene))
-    for (const ContactSpot& spot : m.spots()) spotted.insert({spot.link, f});
+  for (const auto& [sp, sf] : spotSurfaces(*sc.scene, m, contactPairs(tr))) spotted.insert({m.spots()[sp].link, sf});
+  std::vector<Eigen::Isometry3d> to_surface;
+  for (const Surface& sf : surfaces) to_surface.push_back(sf.frame.inverse());
   std::vector<std::vector<std::pair<Eigen::Vector3d, double>>> spheres(m.numLinks());
   for (int l = 0; l < m.numLinks(); ++l)
     for (const CollisionShape& sh : m.links()[l].shapes)
@@ -208,9 +218,8 @@ std::vector<std::pair<int, int>> bodyContactPairs(const Scenario& sc, const Traj
       const Eigen::Isometry3d X = kin.linkPose(l);
       for (int sf = 0; sf < static_cast<int>(surfaces.size()); ++sf) {
         if (spotted.count({l, sf}) || found.count({l, sf})) continue;
-        const Eigen::Isometry3d to_surface = surfaces[sf].frame.inverse();
         for (const auto& [c, r] : spheres[l]) {
-          const Eigen::Vector3d p = to_surface * (X * c);
+          const Eigen::Vector3d p = to_surface[sf] * (X * c);
           if (p.z() - r < range && p.z() > -kSlab && surfaces[sf].polygon.contains(p.head<2>())) {
             found.insert({l, sf});
             break;
@@ -341,39 +350,30 @@ struct DynamicsSimulator::Impl {
       faces.push_back({X_GH, surfaces[s].frame.inverse(), surfaces[s].polygon});
     }
     tracker.adoptContactTracker(new SurfaceSphereTracker(faces, kSlab, opt.sphere_radius));
-    std::set<std::pair<int, int>> all(pairs.begin(), pairs.end());
-    for (int f : floorSurfaces(*scene))
-      for (int sp = 0; sp < static_cast<int>(m.spots().size()); ++sp) all.insert({sp, f});
     const SimTK::ContactCliqueId robot_clique = SimTK::ContactSurface::createNewContactClique();
-    for (const auto& [sp, sf] : all) {
+    // A sphere on a link that meets surface sf alone.
+    auto addSphere = [&](int link, const Eigen::Vector3d& centre, double radius, int sf, const Sphere& tag) {
+      SimTK::ContactSurface cs(SimTK::ContactGeometry::Sphere(radius), material(surfaces.at(sf).friction));
+      cs.joinClique(robot_clique);
+      for (std::size_t s = 0; s < surfaces.size(); ++s)
+        if (static_cast<int>(s) != sf) cs.joinClique(clique[s]);
+      SimTK::Body& body = matter.updMobilizedBody(link_mobod[link]).updBody();
+      const int on_body = body.addContactSurface(SimTK::Transform(toSimVec(centre)), cs);
+      sphere_bodies.push_back({static_cast<int>(sphere_bodies.size()), {link_mobod[link], on_body}});
+      spheres.push_back(tag);
+    };
+    for (const auto& [sp, sf] : spotSurfaces(*scene, m, pairs)) {
       const ContactSpot& spot = m.spots()[sp];
-      for (const auto& v : spot.polygon.vertices()) {
-        // The sphere's bottom on the spot's plane (spot z points into the body).
-        const Eigen::Vector3d centre = spot.frame * Eigen::Vector3d(v.x(), v.y(), opt.sphere_radius);
-        SimTK::ContactSurface cs(SimTK::ContactGeometry::Sphere(opt.sphere_radius), material(surfaces[sf].friction));
-        cs.joinClique(robot_clique);
-        for (std::size_t s = 0; s < surfaces.size(); ++s)
-          if (static_cast<int>(s) != sf) cs.joinClique(clique[s]);
-        SimTK::Body& body = matter.updMobilizedBody(link_mobod[spot.link]).updBody();
-        const int on_body = body.addContactSurface(SimTK::Transform(toSimVec(centre)), cs);
-        sphere_bodies.push_back({static_cast<int>(sphere_bodies.size()), {link_mobod[spot.link], on_body}});
-        spheres.push_back({sp, sf});
-      }
+      // The spheres' bottoms on the spot's plane (spot z points into the body).
+      for (const auto& v : spot.polygon.vertices())
+        addSphere(spot.link, spot.frame * Eigen::Vector3d(v.x(), v.y(), opt.sphere_radius), opt.sphere_radius, sf,
+                  {sp, sf});
     }
     // The body's shapes on the surfaces they come near (bodyContactPairs).
     for (int b = 0; b < body_pairs; ++b) {
       const auto [link, sf] = bodies[b];
       for (const CollisionShape& sh : m.links().at(link).shapes)
-        for (const auto& [centre, radius] : shapeSpheres(sh, opt.sphere_radius)) {
-          SimTK::ContactSurface cs(SimTK::ContactGeometry::Sphere(radius), material(surfaces.at(sf).friction));
-          cs.joinClique(robot_clique);
-          for (std::size_t s = 0; s < surfaces.size(); ++s)
-            if (static_cast<int>(s) != sf) cs.joinClique(clique[s]);
-          SimTK::Body& body = matter.updMobilizedBody(link_mobod[link]).updBody();
-          const int on_body = body.addContactSurface(SimTK::Transform(toSimVec(centre)), cs);
-          sphere_bodies.push_back({static_cast<int>(sphere_bodies.size()), {link_mobod[link], on_body}});
-          spheres.push_back({-1, sf, b});
-        }
+        for (const auto& [centre, radius] : shapeSpheres(sh, opt.sphere_radius)) addSphere(link, centre, radius, sf, {-1, sf, b});
     }
     system.realizeTopology();
     for (const auto& [k, mb] : sphere_bodies)
