@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "hrp2_bridge/sim/dynamics_simulation.h"
+#include "hrp2_bridge/sim/held_start.h"
 #include "hrp2_bridge/stabilizer_schedule.h"
 #include "hrp2_bridge/trajectory_file.h"
 #include "processes/command_line.h"
@@ -35,7 +36,15 @@ int main(int argc, char** argv) {
   hrp2::DynamicsOptions o;
   bool quiet = false;
   app.add_option("scenario", scenario_path, "scenario file (format acyclic.scenario/1)")->required();
-  app.add_option("--trajectory", trajectory_path, "trajectory file (format acyclic.trajectory/1)")->required();
+  double hold_start = 0;
+  auto* trajectory_opt = app.add_option("--trajectory", trajectory_path, "trajectory file (format acyclic.trajectory/1)");
+  auto* hold_opt = app.add_option("--hold-start", hold_start,
+                                  "instead of a trajectory, hold the scenario's start posture and stance this long, s: "
+                                  "does the start itself stand (or sit) on compliant contacts before a plan moves it?")
+                       ->check(CLI::PositiveNumber);
+  trajectory_opt->excludes(hold_opt);
+  hold_opt->excludes(trajectory_opt);
+
   app.add_option("--report", report_path, "write the report as JSON (format acyclic.simulation/1) to this file")
       ->check(acyclic::proc::InWritableDirectory());
   app.add_option("--slip-bound", o.slip_bound, "a supporting contact slipping more over its phase: slipped, m (default 0.01)");
@@ -78,7 +87,16 @@ int main(int argc, char** argv) {
   hrp2::LoadedTrajectory loaded;
   try {
     o.validate();
-    loaded = hrp2::loadTrajectoryFile(trajectory_path, scenario_path);
+    if (!*hold_opt && !*trajectory_opt) throw std::invalid_argument("give --trajectory FILE or --hold-start SECONDS");
+    if (*hold_opt) {
+      loaded.scenario = Scenario::load(scenario_path);
+      loaded.trajectory = hrp2::heldStart(loaded.scenario, hold_start);
+      char label[64];
+      std::snprintf(label, sizeof label, "the start held %g s", hold_start);
+      trajectory_path = label;
+    } else {
+      loaded = hrp2::loadTrajectoryFile(trajectory_path, scenario_path);
+    }
     if (loaded.trajectory.samples.size() < 2) throw std::invalid_argument(trajectory_path + ": field 'samples': at least two samples");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "acyclic-simulate: %s\n", e.what());

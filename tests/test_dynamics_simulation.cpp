@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "hrp2_bridge/sim/dynamics_simulation.h"
+#include "hrp2_bridge/sim/held_start.h"
 #include "interpolator/interpolator.h"
 #include "planner/model/kinematics.h"
 #include "planner/plan/plan.h"
@@ -34,24 +35,6 @@ const Scenario& floorScenario() {
   return sc;
 }
 
-// The scenario's start posture and stance held for n samples at 200 Hz.
-Trajectory startHeld(const Scenario& sc, int n) {
-  Trajectory tr;
-  tr.dt = 0.005;
-  TrajectoryPhase ph;
-  ph.contacts = sc.start_stance;
-  ph.t_end = n * tr.dt;
-  tr.phases.push_back(ph);
-  for (int k = 0; k <= n; ++k) {
-    TrajectorySample x;
-    x.t = k * tr.dt;
-    x.q = sc.start;
-    x.dq = Eigen::VectorXd::Zero(sc.robot->numJoints());
-    tr.samples.push_back(x);
-  }
-  return tr;
-}
-
 // Standing on both feet, the whole body leaning forward about the ankles by
 // `lean` rad (reached linearly over 1 s, then held for 1 s): the base turns
 // about the ankles' midpoint and the ankle pitch joints turn back, so the
@@ -62,7 +45,7 @@ Trajectory leaningTrajectory(const Scenario& sc, double lean) {
   kin.setConfiguration(sc.start);
   const int r_ankle = m.jointIndex("RLEG_JOINT4"), l_ankle = m.jointIndex("LLEG_JOINT4");
   const Eigen::Vector3d pivot = 0.5 * (kin.jointOrigin(r_ankle) + kin.jointOrigin(l_ankle));
-  Trajectory tr = startHeld(sc, 400);
+  Trajectory tr = hrp2::heldStart(sc, 2.0);
   for (int k = 0; k < static_cast<int>(tr.samples.size()); ++k) {
     const double s = std::min(1.0, k / 200.0), a = lean * s;
     const double rate = k < 200 ? lean / 1.0 : 0.0;
@@ -178,7 +161,7 @@ TEST(DynamicsSimulation, ASupportingContactThatNeverTouchesIsReportedAsSuch) {
 // between the waist and the thighs, seated, as the robot itself would.
 TEST(DynamicsSimulation, ASeatedRobotThatTipsBackSitsOnItsWaist) {
   static const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
-  const Trajectory tr = startHeld(sc, 600);
+  const Trajectory tr = hrp2::heldStart(sc, 3.0);
   hrp2::DynamicsOptions o;
   o.settle = 0;
   // Near a surface in the plan: the waist above the seat. The thighs and the
@@ -359,4 +342,28 @@ TEST(SimulateProcess, HelpBadInputAndAFall) {
   const long rows = std::count(csv.begin(), csv.end(), '\n') - 1;
   EXPECT_GT(rows, 100);
   EXPECT_LT(rows, 800);  // 4 s at most: stopped at the fall
+}
+
+// --hold-start: the scenario's start held, no trajectory file. The chair's
+// seated start tips back off its thighs' patches on the spots alone (the
+// test above); the floor's standing start holds.
+TEST(SimulateProcess, HoldsAScenariosStartWithoutATrajectory) {
+  const std::string exe = test::binaryPath("processes/acyclic-simulate");
+  const std::string floor = test::sourcePath("models/scenarios/step_forward.yaml");
+  const std::string chair = test::sourcePath("models/scenarios/chair_paper.yaml");
+  const auto neither = test::runProcess(exe + " " + floor);
+  EXPECT_EQ(neither.status, 2) << neither.output;
+  EXPECT_NE(neither.output.find("--trajectory FILE or --hold-start SECONDS"), std::string::npos) << neither.output;
+  const auto both = test::runProcess(exe + " " + floor + " --hold-start 1 --trajectory x.json");
+  EXPECT_EQ(both.status, 2) << both.output;
+  const auto negative = test::runProcess(exe + " " + floor + " --hold-start -1");
+  EXPECT_EQ(negative.status, 2) << negative.output;
+
+  const auto stands = test::runProcess(exe + " " + floor + " --hold-start 1");
+  EXPECT_EQ(stands.status, 0) << stands.output;
+  EXPECT_NE(stands.output.find("the start held 1 s, 201 samples"), std::string::npos) << stands.output;
+  EXPECT_NE(stands.output.find("verdict: executed at 1.500 s"), std::string::npos) << stands.output;
+  const auto tips = test::runProcess(exe + " " + chair + " --hold-start 3 --no-body-contacts");
+  EXPECT_EQ(tips.status, 1) << tips.output;
+  EXPECT_NE(tips.output.find("verdict: fell"), std::string::npos) << tips.output;
 }
