@@ -3,10 +3,12 @@
 // with its figures. Exit status: 0 valid, 1 a violation, 2 bad input.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <unistd.h>
 
 #include "processes/command_line.h"
+#include "hrp2_bridge/stabilizer_schedule.h"
 #include "planner/check/plan_check.h"
 #include "planner/check/trajectory_check.h"
 #include "planner/common/format_error.h"
@@ -21,6 +23,14 @@ void printParts(const acyclic::ValidityReport& r, const char* indent) {
     std::printf("%s[%s] %-13s %s\n", indent, tag, p.name.c_str(), p.summary.c_str());
     for (const auto& v : p.violations) std::printf("%s       violation: %s\n", indent, v.c_str());
   }
+}
+
+// "12.3 N (2.2% of the weight) toward 180 deg"
+std::string describePush(const acyclic::Scenario& sc, const acyclic::PushMargin& p) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%.1f N (%.1f%% of the weight) toward %.0f deg", p.weakest,
+                100 * p.weakest / (sc.robot->totalMass() * 9.81), p.weakest_direction_deg);
+  return buf;
 }
 
 std::string describeStance(const acyclic::Scenario& sc, const std::vector<acyclic::ContactSpec>& s) {
@@ -50,6 +60,12 @@ int main(int argc, char** argv) {
                  "trajectory file (format acyclic.trajectory/1) to check against the scenario, sample by sample")
       ->excludes("--plan");
   app.add_flag("-v,--verbose", verbose, "print every check of every stance, not only the failing ones");
+  bool push = false;
+  app.add_flag("--push-margin", push,
+               "also print how marginal the start stance or each plan stance is (not part of the contract): the "
+               "largest horizontal push at the centre of mass its contacts still hold quasi-statically, in its "
+               "weakest of 8 directions (world, degrees from +x toward +y); for a plan the weakest stances")
+      ->excludes("--trajectory");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
   try {
@@ -90,6 +106,18 @@ int main(int argc, char** argv) {
       std::printf("start stance: %s\n", describeStance(sc, sc.start_stance).c_str());
       const acyclic::ValidityReport r = checker.checkPosture(sc.start, sc.start_stance);
       printParts(r, "  ");
+      if (push) {
+        acyclic::Kinematics kin(sc.robot);
+        kin.setConfiguration(sc.start);
+        const acyclic::PushMargin pm = acyclic::QuasiStaticChecker(sc.robot, sc.scene).pushMargin(kin, sc.start_stance);
+        if (pm.computed) {
+          std::printf("  [info] push margin   %s; per direction (0, 45, ... 315 deg):", describePush(sc, pm).c_str());
+          for (double f : pm.per_direction) std::printf(" %.0f", f);
+          std::printf(" N\n");
+        } else {
+          std::printf("  [skip] push margin   not in equilibrium\n");
+        }
+      }
       std::printf("%s\n", r.valid() ? "start stance: valid" : "start stance: INVALID");
       return r.valid() ? 0 : 1;
     }
@@ -116,6 +144,38 @@ int main(int argc, char** argv) {
                   forces_ok ? " ok " : "FAIL", rep.worst_cone_ratio, rep.worst_cone_stance);
     else
       std::printf("  [skip] friction      the plan reports no contact force\n");
+    if (push) {
+      acyclic::Kinematics kin(sc.robot);
+      const acyclic::QuasiStaticChecker statics(sc.robot, sc.scene);
+      std::vector<std::pair<std::size_t, acyclic::PushMargin>> margins;  // (stance, its margin)
+      for (std::size_t i = 0; i < plan.stances.size(); ++i) {
+        kin.setConfiguration(plan.stances[i].configuration);
+        const acyclic::PushMargin pm = statics.pushMargin(kin, plan.stances[i].specs());
+        if (!pm.computed) continue;
+        margins.push_back({i, pm});
+        if (verbose) std::printf("  stance %zu: push margin %s\n", i, describePush(sc, pm).c_str());
+      }
+      std::stable_sort(margins.begin(), margins.end(),
+                       [](const auto& a, const auto& b) { return a.second.weakest < b.second.weakest; });
+      // Where HRP-2's bridge runs its stabilizer (only coplanar feet touch)
+      // feedback holds a small margin; elsewhere the robot plays its
+      // references open-loop, and the margin is all there is.
+      const double tol = acyclic::hrp2::BridgeConfig{}.coplanar_tolerance;
+      for (const bool open_loop : {true, false}) {
+        std::vector<const std::pair<std::size_t, acyclic::PushMargin>*> group;
+        for (const auto& m : margins)
+          if (acyclic::hrp2::onlyCoplanarFeet(plan.stances[m.first].specs(), *sc.robot, *sc.scene, tol) != open_loop)
+            group.push_back(&m);
+        std::printf("  [info] push margin   %zu stances %s", group.size(),
+                    open_loop ? "played open-loop (a contact other than coplanar soles)"
+                              : "on coplanar soles alone (HRP-2's stabilizer on)");
+        for (std::size_t k = 0; k < std::min<std::size_t>(3, group.size()); ++k)
+          std::printf("%s stance %zu %s", k ? ";" : "; the weakest:", group[k]->first,
+                      describePush(sc, group[k]->second).c_str());
+        if (!group.empty()) std::printf("; median %.1f N", group[group.size() / 2]->second.weakest);
+        std::printf("\n");
+      }
+    }
     std::printf("  [%s] sequence      start stance first, goal met last, one contact change per step\n",
                 rep.sequence_violations.empty() ? " ok " : "FAIL");
     for (const auto& v : rep.sequence_violations) std::printf("         violation: %s\n", v.c_str());

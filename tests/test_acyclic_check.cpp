@@ -115,3 +115,31 @@ TEST(AcyclicCheck, ScenarioInputErrorsAreBadInputNotViolations) {
   const acyclic::test::ProcessRun nan = run(with("RLEG_JOINT3: 117.953", "RLEG_JOINT3: .nan"));
   EXPECT_EQ(nan.status, 2) << nan.output;
 }
+
+TEST(AcyclicCheck, PushMarginIsPrintedForTheStartAndAPlansWeakestStances) {
+  const std::string chair = acyclic::test::sourcePath("models/scenarios/chair_table.yaml");
+  const acyclic::test::ProcessRun start = run(chair + " --push-margin");
+  EXPECT_EQ(start.status, 0) << start.output;
+  EXPECT_NE(start.output.find("[info] push margin"), std::string::npos) << start.output;
+  EXPECT_NE(start.output.find("per direction (0, 45, ... 315 deg):"), std::string::npos) << start.output;
+  // Not a verdict: the stored plan is valid. Its stances on the thighs are
+  // played open-loop, the side steps on the soles alone under the stabilizer.
+  const acyclic::test::ProcessRun plan =
+      run(chair + " --push-margin --plan " + acyclic::test::sourcePath("tests/data/chair.plan.json"));
+  EXPECT_EQ(plan.status, 0) << plan.output;
+  const std::size_t open_loop = plan.output.find(" stances played open-loop (a contact other than coplanar soles); the weakest: stance ");
+  const std::size_t feet = plan.output.find(" stances on coplanar soles alone (HRP-2's stabilizer on); the weakest: stance ");
+  ASSERT_NE(open_loop, std::string::npos) << plan.output;
+  ASSERT_NE(feet, std::string::npos) << plan.output;
+  // The two groups count the 84 stances between them.
+  const auto count = [&](std::size_t at) {
+    const std::size_t begin = plan.output.rfind("push margin", at) + std::string("push margin").size();
+    return std::stoi(plan.output.substr(begin, at - begin));
+  };
+  EXPECT_EQ(count(open_loop) + count(feet), 84) << plan.output;
+  EXPECT_GT(count(open_loop), 0);
+  EXPECT_GT(count(feet), 0);
+  EXPECT_NE(plan.output.find("plan: valid"), std::string::npos) << plan.output;
+  const acyclic::test::ProcessRun traj = run(chair + " --push-margin --trajectory x.json");
+  EXPECT_EQ(traj.status, 2) << traj.output;
+}

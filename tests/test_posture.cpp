@@ -1232,3 +1232,44 @@ TEST(PostureGenerator, ARetryGuessIsSolvedWhenTheFirstGuessFails) {
   ASSERT_TRUE(first.success()) << first.reason;
   EXPECT_EQ(first.solves, 1);
 }
+
+// The push margin (QuasiStaticChecker::pushMargin): gravity is the push
+// straight down, so g(q) = J_com^T (0, 0, W) (the sign and the frames the LP
+// relies on); standing on both soles (step_forward's start), a push at the
+// centre of mass tips the robot over the soles' front or back edges, which
+// rigid statics puts at W d / h (d from the centre of mass's projection to
+// the edge, h its height); a stance out of equilibrium has none.
+TEST(QuasiStaticCheck, PushMarginIsTheTippingForceOfTheSupport) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/step_forward.yaml"));
+  Kinematics k(sc.robot);
+  k.setConfiguration(sc.start);
+  const double W = sc.robot->totalMass() * 9.81;
+  const Eigen::VectorXd g = k.gravityTorques();
+  const Eigen::VectorXd jg = k.centerOfMassJacobian().transpose() * Eigen::Vector3d(0, 0, W);
+  EXPECT_LT((g - jg).norm(), 1e-9 * W) << (g - jg).transpose();
+
+  double front = -1e9, back = 1e9, floor_z = 0;
+  for (const ContactSpec& c : sc.start_stance) {
+    const Eigen::Isometry3d T = k.spotPose(c.spot);
+    for (const auto& v : sc.robot->spots()[c.spot].polygon.vertices()) {
+      const Eigen::Vector3d p = T * Eigen::Vector3d(v.x(), v.y(), 0);
+      front = std::max(front, p.x()), back = std::min(back, p.x()), floor_z = p.z();
+    }
+  }
+  const Eigen::Vector3d com = k.centerOfMass();
+  const double h = com.z() - floor_z;
+  const PushMargin pm = QuasiStaticChecker(sc.robot, sc.scene).pushMargin(k, sc.start_stance);
+  ASSERT_TRUE(pm.computed);
+  ASSERT_EQ(pm.per_direction.size(), 8u);
+  EXPECT_NEAR(pm.per_direction[0], W * (front - com.x()) / h, 1e-6 * W);  // +x
+  EXPECT_NEAR(pm.per_direction[4], W * (com.x() - back) / h, 1e-6 * W);   // -x
+  EXPECT_EQ(pm.weakest, *std::min_element(pm.per_direction.begin(), pm.per_direction.end()));
+  EXPECT_EQ(pm.weakest_direction_deg, 180.0);  // the heels are nearer the centre of mass than the toes
+  for (double f : pm.per_direction) EXPECT_GT(f, 0.05 * W);
+
+  // On the right sole alone the centre of mass (between the feet) is outside
+  // the support: no forces balance, no margin.
+  std::vector<ContactSpec> one = sc.start_stance;
+  for (auto& c : one) c.supporting = sc.robot->spots()[c.spot].name == "r_sole";
+  EXPECT_FALSE(QuasiStaticChecker(sc.robot, sc.scene).pushMargin(k, one).computed);
+}

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include "planner/scene/friction.h"
 
@@ -91,33 +92,27 @@ const std::array<Facet, kFrictionPyramidEdges> kFacets = [] {
   return f;
 }();
 
-}  // namespace
+// A supporting contact's polygon corner: world point, its surface's normal
+// and tangent axes and friction, and the corner's J^T columns (Simbody).
+struct Corner {
+  int contact;
+  Eigen::Vector3d p, n, t1, t2;
+  double mu;
+  Eigen::MatrixXd JT;  // nt x 3
+};
 
-QuasiStaticChecker::QuasiStaticChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
-    : robot_(std::move(robot)), scene_(std::move(scene)) {}
-
-QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const {
-  QuasiStaticReport rep;
-  if (!margin_computed_) rep.margin = std::numeric_limits<double>::quiet_NaN();
-  const RobotModel& m = *robot_;
-  const int nt = m.tangentSize();
-  const double W = m.totalMass() * 9.81;
-  const Eigen::VectorXd g = kin.gravityTorques();  // Simbody
-
-  // Corners of the supporting contacts, their surface axes, and J^T columns (Simbody).
-  struct Corner {
-    int contact;
-    Eigen::Vector3d p, n, t1, t2;
-    double mu;
-    Eigen::MatrixXd JT;  // nt x 3
-  };
+// The corners of a stance's supporting contacts at the kinematics'
+// configuration; `supporting` counts those contacts.
+std::vector<Corner> supportingCorners(const RobotModel& m, const Scene& scene, const Kinematics& kin,
+                                      const std::vector<ContactSpec>& stance, int& supporting) {
   std::vector<Corner> corners;
+  supporting = 0;
   for (std::size_t ci = 0; ci < stance.size(); ++ci) {
     const ContactSpec& c = stance[ci];
     if (!c.supporting) continue;
-    ++rep.supporting_contacts;
+    ++supporting;
     const ContactSpot& spot = m.spots()[c.spot];
-    const Surface& s = scene_->surfaces()[c.surface];
+    const Surface& s = scene.surfaces()[c.surface];
     const Eigen::Isometry3d Tspot = kin.spotPose(c.spot);
     // One frame Jacobian at the spot's origin (Simbody) gives every corner's:
     // v_p = v_o + w x (p - o), so each column of J_p is J_v's plus J_w's
@@ -138,6 +133,57 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
       corners.push_back(k);
     }
   }
+  return corners;
+}
+
+// Columns (f_n, f_t1, f_t2) for each corner, from column 0.
+void addCornerColumns(Lp& lp, std::size_t corners) {
+  for (std::size_t k = 0; k < corners; ++k) {
+    lp.addCol(0, COIN_DBL_MAX, 0);
+    lp.addCol(-COIN_DBL_MAX, COIN_DBL_MAX, 0);
+    lp.addCol(-COIN_DBL_MAX, COIN_DBL_MAX, 0);
+  }
+}
+
+// Row i of sum J^T f over the corners' columns.
+std::vector<std::pair<int, double>> generalizedForceRow(const std::vector<Corner>& corners, int i) {
+  std::vector<std::pair<int, double>> row;
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const Corner& c = corners[k];
+    row.push_back({3 * static_cast<int>(k), c.JT.row(i).dot(c.n)});
+    row.push_back({3 * static_cast<int>(k) + 1, c.JT.row(i).dot(c.t1)});
+    row.push_back({3 * static_cast<int>(k) + 2, c.JT.row(i).dot(c.t2)});
+  }
+  return row;
+}
+
+// The contract's friction pyramid at each corner by its facets:
+// mu cos(pi/E) f_n - (cos a f_t1 + sin a f_t2) >= s, s the column `margin`
+// (LP 1) or 0 (margin < 0), a = 2 pi (m + 1/2) / E the facet's outward direction.
+void addFacetRows(Lp& lp, const std::vector<Corner>& corners, int margin) {
+  for (std::size_t k = 0; k < corners.size(); ++k)
+    for (const Facet& f : kFacets) {
+      const int c = 3 * static_cast<int>(k);
+      std::vector<std::pair<int, double>> row = {{c, corners[k].mu * f.inset}, {c + 1, -f.cos}, {c + 2, -f.sin}};
+      if (margin >= 0) row.push_back({margin, -1.0});
+      lp.addRow(row, 0, COIN_DBL_MAX);
+    }
+}
+
+}  // namespace
+
+QuasiStaticChecker::QuasiStaticChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene)
+    : robot_(std::move(robot)), scene_(std::move(scene)) {}
+
+QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const {
+  QuasiStaticReport rep;
+  if (!margin_computed_) rep.margin = std::numeric_limits<double>::quiet_NaN();
+  const RobotModel& m = *robot_;
+  const int nt = m.tangentSize();
+  const double W = m.totalMass() * 9.81;
+  const Eigen::VectorXd g = kin.gravityTorques();  // Simbody
+
+  const std::vector<Corner> corners = supportingCorners(m, *scene_, kin, stance, rep.supporting_contacts);
   if (corners.empty()) {
     rep.reason = "no supporting contact";
     return rep;
@@ -145,22 +191,12 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
 
   // Columns: per corner (f_n, f_t1, f_t2), then the LP's own variable (s or t).
   auto build = [&](Lp& lp, bool margin_lp) {
-    for (std::size_t k = 0; k < corners.size(); ++k) {
-      lp.addCol(0, COIN_DBL_MAX, 0);
-      lp.addCol(-COIN_DBL_MAX, COIN_DBL_MAX, 0);
-      lp.addCol(-COIN_DBL_MAX, COIN_DBL_MAX, 0);
-    }
+    addCornerColumns(lp, corners.size());
     const int extra = margin_lp ? lp.addCol(-W, W, -1.0)   // maximize s
                                 : lp.addCol(0, COIN_DBL_MAX, 1.0);  // minimize t
     // Generalized force rows: (J^T f)_i for each tangent index i.
     for (int i = 0; i < nt; ++i) {
-      std::vector<std::pair<int, double>> row;
-      for (std::size_t k = 0; k < corners.size(); ++k) {
-        const Corner& c = corners[k];
-        row.push_back({3 * k, c.JT.row(i).dot(c.n)});
-        row.push_back({3 * k + 1, c.JT.row(i).dot(c.t1)});
-        row.push_back({3 * k + 2, c.JT.row(i).dot(c.t2)});
-      }
+      const std::vector<std::pair<int, double>> row = generalizedForceRow(corners, i);
       if (i < 6) {
         lp.addRow(row, g[i], g[i]);  // the base: forces and moments balance gravity
       } else {
@@ -178,15 +214,8 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
       }
     }
     // Friction: the contract's pyramid inscribed in the cone (friction.h),
-    // by its facets: mu cos(pi/E) f_n - (cos a f_t1 + sin a f_t2) >= s (LP 1)
-    // or >= 0 (LP 2), a = 2 pi (m + 1/2) / E the facet's outward direction.
-    for (std::size_t k = 0; k < corners.size(); ++k)
-      for (const Facet& f : kFacets) {
-        std::vector<std::pair<int, double>> row = {
-            {3 * k, corners[k].mu * f.inset}, {3 * k + 1, -f.cos}, {3 * k + 2, -f.sin}};
-        if (margin_lp) row.push_back({extra, -1.0});
-        lp.addRow(row, 0, COIN_DBL_MAX);
-      }
+    // by its facets, inside by s (LP 1) or 0 (LP 2).
+    addFacetRows(lp, corners, margin_lp ? extra : -1);
     return extra;
   };
 
@@ -298,6 +327,47 @@ QuasiStaticReport QuasiStaticChecker::check(const Kinematics& kin, const std::ve
     rep.reason = os.str();
   }
   return rep;
+}
+
+PushMargin QuasiStaticChecker::pushMargin(const Kinematics& kin, const std::vector<ContactSpec>& stance,
+                                          int directions) const {
+  if (directions < 1) throw std::invalid_argument("pushMargin: at least one direction");
+  PushMargin out;
+  const RobotModel& m = *robot_;
+  const int nt = m.tangentSize();
+  const double W = m.totalMass() * 9.81;
+  int supporting = 0;
+  const std::vector<Corner> corners = supportingCorners(m, *scene_, kin, stance, supporting);
+  if (corners.empty()) return out;
+  const Eigen::VectorXd g = kin.gravityTorques();
+  // A force F at the centre of mass has the generalized force J_com^T F
+  // (gravity's is J_com^T (0, 0, -W), so g = J_com^T (0, 0, W)); held, it
+  // adds -J_com^T F to what the joints and the contacts must supply.
+  const Eigen::MatrixXd Jc = kin.centerOfMassJacobian();
+  out.per_direction.assign(directions, 0.0);
+  for (int k = 0; k < directions; ++k) {
+    const double a = 2 * M_PI * k / directions;
+    const Eigen::VectorXd push = Jc.transpose() * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+    Lp lp;
+    addCornerColumns(lp, corners.size());
+    const int s_col = lp.addCol(0, W, -1.0);  // maximize s
+    for (int i = 0; i < nt; ++i) {
+      // (J^T f)_i + s push_i = g_i at the base; within the limit of g_i at a joint.
+      std::vector<std::pair<int, double>> row = generalizedForceRow(corners, i);
+      row.push_back({s_col, push[i]});
+      const double lim = i < 6 ? 0.0 : m.joints()[i - 6].effort;
+      lp.addRow(row, g[i] - lim, g[i] + lim);
+    }
+    addFacetRows(lp, corners, -1);
+    std::vector<double> x;
+    if (!lp.solve(x, nullptr)) return PushMargin{};  // not even s = 0: the stance is not in equilibrium
+    out.per_direction[k] = std::max(0.0, x[s_col]);
+  }
+  const auto weakest = std::min_element(out.per_direction.begin(), out.per_direction.end());
+  out.weakest = *weakest;
+  out.weakest_direction_deg = 360.0 * (weakest - out.per_direction.begin()) / directions;
+  out.computed = true;
+  return out;
 }
 
 }  // namespace acyclic

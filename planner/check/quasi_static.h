@@ -39,6 +39,17 @@ struct QuasiStaticReport {
   std::vector<std::vector<Eigen::Vector3d>> points, forces;
 };
 
+// How hard a stance can be pushed (QuasiStaticChecker::pushMargin): the
+// largest horizontal force at the centre of mass that its supporting
+// contacts still balance, quasi-statically (forces in their pyramids,
+// torques within limits), in each of `directions` world directions.
+struct PushMargin {
+  bool computed = false;             // false: no supporting contact, or the stance is not in equilibrium
+  double weakest = 0;                // N: the smallest over the directions (capped at the weight)
+  double weakest_direction_deg = 0;  // its direction in the world's x-y plane, from +x toward +y
+  std::vector<double> per_direction; // N, direction k at 360 k / directions degrees
+};
+
 class QuasiStaticChecker {
  public:
   QuasiStaticChecker(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene);
@@ -46,6 +57,18 @@ class QuasiStaticChecker {
   QuasiStaticReport check(const Kinematics& kin, const std::vector<ContactSpec>& stance) const;
 
   double residualTolerance() const { return 1e-6; }  // relative, docs/design.md section 9
+
+  // Not part of the contract: a figure of how marginal a valid stance is.
+  // For each direction d (k 360 / directions degrees about the vertical),
+  // the largest s in [0, W] with forces in their pyramids such that
+  // sum J^T f + s J_com^T d balances g(q) at the base and keeps every
+  // joint's torque within its limit: a push s d at the centre of mass held
+  // still. Rigid contacts: a stance with its centre of mass millimetres
+  // inside an edge is valid, and its margin toward that edge is a few
+  // newtons (chair_paper's seated start backward), which the compliant
+  // contacts of the simulation and of the robot do not give (docs/design.md
+  // section 12). One LP per direction, from scratch.
+  PushMargin pushMargin(const Kinematics& kin, const std::vector<ContactSpec>& stance, int directions = 8) const;
 
   // Off by default. On, each LP starts from the last optimal basis of the
   // same size: checks along a trajectory follow each other closely, so the
