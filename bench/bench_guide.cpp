@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   app.add_flag("--ompl-only", ompl_only, "plan with the OMPL guide only, not also with the hand-written key postures");
   CLI11_PARSE(app, argc, argv);
   if (paths.empty()) paths = bench::shippedScenarios();
+  if (!overrides.acceptedBy(paths, "bench_guide")) return 2;
   std::printf("%-14s %-18s %12s %12s %8s\n", "scenario", "guide", "median s", "max s", "keys");
   std::vector<Guide> guides;
   for (const auto& path : paths) {

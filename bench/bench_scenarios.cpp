@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   if (paths.empty()) paths = bench::shippedScenarios();
+  if (!overrides.acceptedBy(paths, "bench_scenarios")) return 2;
   std::printf("%-14s %-16s %9s %7s %7s %7s %8s %-7s %s\n", "scenario", "result", "seconds", "nodes", "calls",
               "failed", "stances", "check", "non-foot contacts used");
   for (const auto& path : paths) {

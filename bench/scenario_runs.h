@@ -36,6 +36,7 @@ struct PlannerOverrides {
   long max_nodes = -1;
   long max_posture_calls = -1;
   bool verify = false;  // verify transitions (the planner's default in acyclic-planner)
+  std::string member;   // of the scenario's portfolio, alone (empty: the whole portfolio)
 
   // --max-seconds, --max-nodes, --max-posture-calls (each per `per`), and
   // --verify-transitions where the interpolator is built.
@@ -47,11 +48,26 @@ struct PlannerOverrides {
     app.add_option("--max-posture-calls", max_posture_calls,
                    "posture-generator calls at most per " + per + " (default: the scenario's)")
         ->check(positive());
+    app.add_option("--member", member,
+                   "of the scenario's portfolio (planner: portfolio), plan with this member alone, by name, as "
+                   "acyclic-planner --member (default: the whole portfolio)");
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
     app.add_flag("--verify-transitions", verify,
                  "verify each plan's transitions with the interpolator's solver, as acyclic-planner does by default "
                  "(default here: the search alone, or the scenario's planner key verify_transitions)");
 #endif
+  }
+
+  // Whether every scenario loads and takes these changes (an unknown
+  // --member, a bad scenario): false, with the reason on stderr, if not.
+  bool acceptedBy(const std::vector<std::string>& paths, const char* bench) const {
+    try {
+      for (const auto& path : paths) parameters(Scenario::load(path));
+      return true;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "%s: %s\n", bench, e.what());
+      return false;
+    }
   }
 
   // The scenario's parameters with these changes, and a verifier when they
@@ -62,6 +78,13 @@ struct PlannerOverrides {
     if (max_nodes > 0) p.max_nodes = max_nodes;
     if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
     if (verify) p.verify_transitions = true;
+    if (!member.empty()) {
+      try {
+        keepPortfolioMember(p, member);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(sc.path + ": --member: " + e.what());
+      }
+    }
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
     attachPlanVerifier(p, sc);
 #endif
