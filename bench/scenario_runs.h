@@ -38,8 +38,8 @@ struct PlannerOverrides {
   bool verify = false;  // verify transitions (the planner's default in acyclic-planner)
   std::string member;   // of the scenario's portfolio, alone (empty: the whole portfolio)
 
-  // --max-seconds, --max-nodes, --max-posture-calls (each per `per`), and
-  // --verify-transitions where the interpolator is built.
+  // --max-seconds, --max-nodes, --max-posture-calls (each per `per`),
+  // --member, and --verify-transitions where the interpolator is built.
   void addOptions(CLI::App& app, const std::string& per) {
     app.add_option("--max-seconds", max_seconds, "time budget per " + per + ", s (default: the scenario's)")
         ->check(positive());

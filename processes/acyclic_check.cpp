@@ -8,8 +8,10 @@
 #include <unistd.h>
 
 #include "processes/command_line.h"
-#include "hrp2_bridge/stabilizer_schedule.h"
 #include "planner/check/plan_check.h"
+#ifdef ACYCLIC_HAVE_HRP2_BRIDGE
+#include "hrp2_bridge/stabilizer_schedule.h"
+#endif
 #include "planner/check/trajectory_check.h"
 #include "planner/common/format_error.h"
 #include "planner/scene/scenario.h"
@@ -148,10 +150,14 @@ int main(int argc, char** argv) {
       acyclic::Kinematics kin(sc.robot);
       const acyclic::QuasiStaticChecker statics(sc.robot, sc.scene);
       std::vector<std::pair<std::size_t, acyclic::PushMargin>> margins;  // (stance, its margin)
+      std::size_t skipped = 0;  // stances that fail the contract, or out of equilibrium
       for (std::size_t i = 0; i < plan.stances.size(); ++i) {
         kin.setConfiguration(plan.stances[i].configuration);
         const acyclic::PushMargin pm = statics.pushMargin(kin, plan.stances[i].specs());
-        if (!pm.computed) continue;
+        if (!pm.computed || !rep.stances[i].valid()) {
+          ++skipped;
+          continue;
+        }
         margins.push_back({i, pm});
         if (verbose) std::printf("  stance %zu: push margin %s\n", i, describePush(sc, pm).c_str());
       }
@@ -159,22 +165,33 @@ int main(int argc, char** argv) {
                        [](const auto& a, const auto& b) { return a.second.weakest < b.second.weakest; });
       // Where HRP-2's bridge runs its stabilizer (only coplanar feet touch)
       // feedback holds a small margin; elsewhere the robot plays its
-      // references open-loop, and the margin is all there is.
+      // references open-loop, and the margin is all there is. Per stance:
+      // the bridge also switches the stabilizer off a little before a
+      // contact that is not a coplanar sole is made, and on a little after.
+      std::vector<std::pair<std::string, std::vector<const std::pair<std::size_t, acyclic::PushMargin>*>>> groups;
+#ifdef ACYCLIC_HAVE_HRP2_BRIDGE
       const double tol = acyclic::hrp2::BridgeConfig{}.coplanar_tolerance;
       for (const bool open_loop : {true, false}) {
-        std::vector<const std::pair<std::size_t, acyclic::PushMargin>*> group;
+        groups.push_back({open_loop ? "played open-loop (a contact other than coplanar soles)"
+                                    : "on coplanar soles alone (where HRP-2's bridge runs its stabilizer)",
+                          {}});
         for (const auto& m : margins)
           if (acyclic::hrp2::onlyCoplanarFeet(plan.stances[m.first].specs(), *sc.robot, *sc.scene, tol) != open_loop)
-            group.push_back(&m);
-        std::printf("  [info] push margin   %zu stances %s", group.size(),
-                    open_loop ? "played open-loop (a contact other than coplanar soles)"
-                              : "on coplanar soles alone (HRP-2's stabilizer on)");
+            groups.back().second.push_back(&m);
+      }
+#else
+      groups.push_back({"valid", {}});
+      for (const auto& m : margins) groups.back().second.push_back(&m);
+#endif
+      for (const auto& [label, group] : groups) {
+        std::printf("  [info] push margin   %zu stances %s", group.size(), label.c_str());
         for (std::size_t k = 0; k < std::min<std::size_t>(3, group.size()); ++k)
           std::printf("%s stance %zu %s", k ? ";" : "; the weakest:", group[k]->first,
                       describePush(sc, group[k]->second).c_str());
         if (!group.empty()) std::printf("; median %.1f N", group[group.size() / 2]->second.weakest);
         std::printf("\n");
       }
+      if (skipped) std::printf("  [info] push margin   %zu stances left out (invalid, or out of equilibrium)\n", skipped);
     }
     std::printf("  [%s] sequence      start stance first, goal met last, one contact change per step\n",
                 rep.sequence_violations.empty() ? " ok " : "FAIL");

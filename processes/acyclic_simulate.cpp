@@ -42,8 +42,7 @@ int main(int argc, char** argv) {
                                   "instead of a trajectory, hold the scenario's start posture and stance this long, s: "
                                   "does the start itself stand (or sit) on compliant contacts before a plan moves it?")
                        ->check(CLI::PositiveNumber);
-  trajectory_opt->excludes(hold_opt);
-  hold_opt->excludes(trajectory_opt);
+  trajectory_opt->excludes(hold_opt);  // CLI11: both ways
 
   app.add_option("--report", report_path, "write the report as JSON (format acyclic.simulation/1) to this file")
       ->check(acyclic::proc::InWritableDirectory());

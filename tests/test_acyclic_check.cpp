@@ -128,7 +128,7 @@ TEST(AcyclicCheck, PushMarginIsPrintedForTheStartAndAPlansWeakestStances) {
       run(chair + " --push-margin --plan " + acyclic::test::sourcePath("tests/data/chair.plan.json"));
   EXPECT_EQ(plan.status, 0) << plan.output;
   const std::size_t open_loop = plan.output.find(" stances played open-loop (a contact other than coplanar soles); the weakest: stance ");
-  const std::size_t feet = plan.output.find(" stances on coplanar soles alone (HRP-2's stabilizer on); the weakest: stance ");
+  const std::size_t feet = plan.output.find(" stances on coplanar soles alone (where HRP-2's bridge runs its stabilizer); the weakest: stance ");
   ASSERT_NE(open_loop, std::string::npos) << plan.output;
   ASSERT_NE(feet, std::string::npos) << plan.output;
   // The two groups count the 84 stances between them.
@@ -142,4 +142,5 @@ TEST(AcyclicCheck, PushMarginIsPrintedForTheStartAndAPlansWeakestStances) {
   EXPECT_NE(plan.output.find("plan: valid"), std::string::npos) << plan.output;
   const acyclic::test::ProcessRun traj = run(chair + " --push-margin --trajectory x.json");
   EXPECT_EQ(traj.status, 2) << traj.output;
+  EXPECT_NE(traj.output.find("excludes"), std::string::npos) << "refused by the options, before any file\n" << traj.output;
 }

@@ -1263,12 +1263,15 @@ TEST(QuasiStaticCheck, PushMarginIsTheTippingForceOfTheSupport) {
   ASSERT_EQ(pm.per_direction.size(), 8u);
   EXPECT_NEAR(pm.per_direction[0], W * (front - com.x()) / h, 1e-6 * W);  // +x
   EXPECT_NEAR(pm.per_direction[4], W * (com.x() - back) / h, 1e-6 * W);   // -x
-  EXPECT_EQ(pm.weakest, *std::min_element(pm.per_direction.begin(), pm.per_direction.end()));
-  EXPECT_EQ(pm.weakest_direction_deg, 180.0);  // the heels are nearer the centre of mass than the toes
+  // The heels are nearer the centre of mass than the toes, and nearer than
+  // the soles' outer edges: backward is the weakest direction.
+  EXPECT_EQ(pm.weakest_direction_deg, 180.0);
+  EXPECT_EQ(pm.weakest, pm.per_direction[4]);
   for (double f : pm.per_direction) EXPECT_GT(f, 0.05 * W);
 
   // On the right sole alone the centre of mass (between the feet) is outside
-  // the support: no forces balance, no margin.
+  // the support: no forces balance, no margin (a push toward the right
+  // would hold it there, which is no margin either).
   std::vector<ContactSpec> one = sc.start_stance;
   for (auto& c : one) c.supporting = sc.robot->spots()[c.spot].name == "r_sole";
   EXPECT_FALSE(QuasiStaticChecker(sc.robot, sc.scene).pushMargin(k, one).computed);

@@ -9,6 +9,8 @@ namespace acyclic::hrp2 {
 Trajectory heldStart(const Scenario& sc, double seconds, double dt) {
   if (!(std::isfinite(seconds) && seconds > 0)) throw std::invalid_argument("the time to hold the start must be positive");
   if (!(std::isfinite(dt) && dt > 0)) throw std::invalid_argument("the sample period must be positive");
+  // A day at the controller's 200 Hz at most: more is a typo, not a test.
+  if (seconds / dt > 2e7) throw std::invalid_argument("the time to hold the start is over 2e7 samples");
   const int n = std::max(1, static_cast<int>(std::lround(seconds / dt)));
   Trajectory tr;
   tr.scenario = sc.path;

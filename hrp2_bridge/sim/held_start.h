@@ -12,7 +12,8 @@ namespace acyclic::hrp2 {
 
 // The start configuration at rest for `seconds` (at least one period), sampled
 // every `dt`, in one phase whose contacts are the start stance's.
-// std::invalid_argument when seconds or dt is not positive and finite.
+// std::invalid_argument when seconds or dt is not positive and finite, or
+// when that is over 2e7 samples.
 Trajectory heldStart(const Scenario& sc, double seconds, double dt = 0.005);
 
 }  // namespace acyclic::hrp2

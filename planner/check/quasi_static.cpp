@@ -344,29 +344,37 @@ PushMargin QuasiStaticChecker::pushMargin(const Kinematics& kin, const std::vect
   // (gravity's is J_com^T (0, 0, -W), so g = J_com^T (0, 0, W)); held, it
   // adds -J_com^T F to what the joints and the contacts must supply.
   const Eigen::MatrixXd Jc = kin.centerOfMassJacobian();
-  out.per_direction.assign(directions, 0.0);
-  for (int k = 0; k < directions; ++k) {
-    const double a = 2 * M_PI * k / directions;
-    const Eigen::VectorXd push = Jc.transpose() * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+  // The push s d held: (J^T f)_i + s push_i = g_i at the base, within the
+  // limit of g_i at a joint; s in [0, s_max], maximized. x[s_col] on success.
+  auto solve = [&](const Eigen::Vector3d& d, double s_max, std::vector<double>& x) {
+    const Eigen::VectorXd push = Jc.transpose() * d;
     Lp lp;
     addCornerColumns(lp, corners.size());
-    const int s_col = lp.addCol(0, W, -1.0);  // maximize s
+    const int s_col = lp.addCol(0, s_max, -1.0);
     for (int i = 0; i < nt; ++i) {
-      // (J^T f)_i + s push_i = g_i at the base; within the limit of g_i at a joint.
       std::vector<std::pair<int, double>> row = generalizedForceRow(corners, i);
       row.push_back({s_col, push[i]});
       const double lim = i < 6 ? 0.0 : m.joints()[i - 6].effort;
       lp.addRow(row, g[i] - lim, g[i] + lim);
     }
     addFacetRows(lp, corners, -1);
-    std::vector<double> x;
-    if (!lp.solve(x, nullptr)) return PushMargin{};  // not even s = 0: the stance is not in equilibrium
-    out.per_direction[k] = std::max(0.0, x[s_col]);
+    return lp.solve(x, nullptr) ? std::max(0.0, x[s_col]) : -1.0;
+  };
+  // Without a push first: a stance out of equilibrium can be held with
+  // one (the push moves the resultant's line into the support), which is
+  // no margin. With it, each direction's feasible pushes are [0, s_max]
+  // (the LP is convex), and a direction whose LP fails (numerically) counts 0.
+  std::vector<double> x;
+  if (solve(Eigen::Vector3d::UnitX(), 0.0, x) < 0) return out;
+  out.per_direction.assign(directions, 0.0);
+  for (int k = 0; k < directions; ++k) {
+    const double a = 2 * M_PI * k / directions;
+    out.per_direction[k] = std::max(0.0, solve(Eigen::Vector3d(std::cos(a), std::sin(a), 0), W, x));
   }
+  out.computed = true;
   const auto weakest = std::min_element(out.per_direction.begin(), out.per_direction.end());
   out.weakest = *weakest;
   out.weakest_direction_deg = 360.0 * (weakest - out.per_direction.begin()) / directions;
-  out.computed = true;
   return out;
 }
 

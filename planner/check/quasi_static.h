@@ -63,11 +63,14 @@ class QuasiStaticChecker {
   // the largest s in [0, W] with forces in their pyramids such that
   // sum J^T f + s J_com^T d balances g(q) at the base and keeps every
   // joint's torque within its limit: a push s d at the centre of mass held
-  // still. Rigid contacts: a stance with its centre of mass millimetres
-  // inside an edge is valid, and its margin toward that edge is a few
-  // newtons (chair_paper's seated start backward), which the compliant
-  // contacts of the simulation and of the robot do not give (docs/design.md
-  // section 12). One LP per direction, from scratch.
+  // still. Rigid contacts: a stance on one sole with its centre of mass
+  // millimetres inside an edge is valid, and its margin toward that edge is
+  // a few newtons, which the compliant soles and servos of the simulation
+  // and of the robot do not hold open-loop. Forces are free to
+  // redistribute, so a stance held by a squeeze can show a large margin
+  // that position servos do not realize (docs/design.md section 9). One LP
+  // without a push (none if it fails: out of equilibrium), then one per
+  // direction, from scratch; a direction whose LP fails counts as 0.
   PushMargin pushMargin(const Kinematics& kin, const std::vector<ContactSpec>& stance, int directions = 8) const;
 
   // Off by default. On, each LP starts from the last optimal basis of the
