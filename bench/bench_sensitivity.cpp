@@ -118,13 +118,7 @@ int main(int argc, char** argv) {
                                     "'s robot and a surface of its scene");
     }
     shipped = plannerParameters(loaded);
-    if (!member.empty()) {
-      try {
-        keepPortfolioMember(shipped, member);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(path + ": --member: " + e.what());
-      }
-    }
+    if (!member.empty()) keepPortfolioMember(shipped, member, path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_sensitivity: %s\n", e.what());
     return 2;

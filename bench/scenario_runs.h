@@ -78,13 +78,7 @@ struct PlannerOverrides {
     if (max_nodes > 0) p.max_nodes = max_nodes;
     if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
     if (verify) p.verify_transitions = true;
-    if (!member.empty()) {
-      try {
-        keepPortfolioMember(p, member);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(sc.path + ": --member: " + e.what());
-      }
-    }
+    if (!member.empty()) keepPortfolioMember(p, member, sc.path);
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
     attachPlanVerifier(p, sc);
 #endif

@@ -32,13 +32,7 @@ constexpr bool kVerifyTransitionsByDefault = false;  // nothing to verify with
 PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s) const {
   if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
   PlannerParameters p = plannerParameters(sc);
-  if (!member.empty()) {
-    try {
-      keepPortfolioMember(p, member);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("--member: " + sc.name + ": " + e.what());
-    }
-  }
+  if (!member.empty()) keepPortfolioMember(p, member, sc.name);
   if (request_budget_s > 0) p.max_seconds = request_budget_s;
   if (max_seconds > 0) p.max_seconds = max_seconds;
   if (max_nodes > 0) p.max_nodes = max_nodes;

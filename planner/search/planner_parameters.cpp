@@ -146,7 +146,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   return p;
 }
 
-void keepPortfolioMember(PlannerParameters& p, const std::string& name) {
+void keepPortfolioMember(PlannerParameters& p, const std::string& name, const std::string& scenario) {
   std::string names;
   for (const PlannerVariant& v : p.portfolio) {
     if (v.name != name) {
@@ -158,7 +158,7 @@ void keepPortfolioMember(PlannerParameters& p, const std::string& name) {
     if (member.apply) member.apply(p);
     return;
   }
-  throw std::invalid_argument("no portfolio member named \"" + name + "\" (" +
+  throw std::invalid_argument(scenario + ": --member: no portfolio member named \"" + name + "\" (" +
                               (names.empty() ? std::string("the scenario has no portfolio") : "its members: " + names) +
                               ")");
 }

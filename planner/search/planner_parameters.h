@@ -10,7 +10,8 @@ PlannerParameters plannerParameters(const Scenario& sc);
 
 // p's portfolio member of that name applied to p, and the portfolio
 // dropped: that member planned alone, on all of p's threads
-// (std::invalid_argument naming the members when there is no such one).
-void keepPortfolioMember(PlannerParameters& p, const std::string& name);
+// (std::invalid_argument naming `scenario`, the option and the members when
+// there is no such one).
+void keepPortfolioMember(PlannerParameters& p, const std::string& name, const std::string& scenario);
 
 }  // namespace acyclic
