@@ -344,6 +344,9 @@ PushMargin QuasiStaticChecker::pushMargin(const Kinematics& kin, const std::vect
   // (gravity's is J_com^T (0, 0, -W), so g = J_com^T (0, 0, W)); held, it
   // adds -J_com^T F to what the joints and the contacts must supply.
   const Eigen::MatrixXd Jc = kin.centerOfMassJacobian();
+  // Rows of sum J^T f, the same in every direction's LP.
+  std::vector<std::vector<std::pair<int, double>>> force_rows(nt);
+  for (int i = 0; i < nt; ++i) force_rows[i] = generalizedForceRow(corners, i);
   // The push s d held: (J^T f)_i + s push_i = g_i at the base, within the
   // limit of g_i at a joint; s in [0, s_max], maximized. x[s_col] on success.
   auto solve = [&](const Eigen::Vector3d& d, double s_max, std::vector<double>& x) {
@@ -352,7 +355,7 @@ PushMargin QuasiStaticChecker::pushMargin(const Kinematics& kin, const std::vect
     addCornerColumns(lp, corners.size());
     const int s_col = lp.addCol(0, s_max, -1.0);
     for (int i = 0; i < nt; ++i) {
-      std::vector<std::pair<int, double>> row = generalizedForceRow(corners, i);
+      std::vector<std::pair<int, double>> row = force_rows[i];
       row.push_back({s_col, push[i]});
       const double lim = i < 6 ? 0.0 : m.joints()[i - 6].effort;
       lp.addRow(row, g[i] - lim, g[i] + lim);
