@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -67,7 +68,8 @@ int main(int argc, char** argv) {
     for (const auto& p : acyclic::bench::makeProblems(sc, problems, seed)) pg.solve(p.request);
     kkt::observeFactorizations(nullptr);
   }
-  std::vector<double> t_factor, t_solve;
+  std::vector<double> t_factor, t_solve, t_six_singly, t_six_at_once;
+  int differing = 0;  // systems whose solveMany results differ in a bit from solve's
   double rows = 0, entries = 0, block = 0;
   for (const Matrix& m : kept) {
     const int n = m.n;
@@ -93,6 +95,28 @@ int main(int argc, char** argv) {
     }
     t1 = std::chrono::steady_clock::now();
     t_solve.push_back(std::chrono::duration<double>(t1 - t0).count() / reps);
+    // Six right-hand sides (L-BFGS's update vectors), one by one and at once.
+    constexpr int kMany = 6;
+    Eigen::MatrixXd B(n, kMany), X(n, kMany);
+    for (int c = 0; c < kMany; ++c) B.col(c) = b * (1.0 + c) + Eigen::VectorXd::Constant(n, 0.1 * c);
+    std::vector<double> many_work(static_cast<std::size_t>(n) * kkt::kMaxSolvedAtOnce);
+    t0 = std::chrono::steady_clock::now();
+    for (int r = 0; r < reps; ++r) {
+      X = B;
+      for (int c = 0; c < kMany; ++c)
+        kkt::solve(n, perm.data(), Lp.data(), Li.data(), Lx.data(), D.data(), X.col(c).data(), work.data());
+    }
+    t1 = std::chrono::steady_clock::now();
+    t_six_singly.push_back(std::chrono::duration<double>(t1 - t0).count() / reps);
+    const Eigen::MatrixXd singly = X;
+    t0 = std::chrono::steady_clock::now();
+    for (int r = 0; r < reps; ++r) {
+      X = B;
+      kkt::solveMany(n, kMany, perm.data(), Lp.data(), Li.data(), Lx.data(), D.data(), X.data(), many_work.data());
+    }
+    t1 = std::chrono::steady_clock::now();
+    t_six_at_once.push_back(std::chrono::duration<double>(t1 - t0).count() / reps);
+    if (std::memcmp(X.data(), singly.data(), sizeof(double) * static_cast<std::size_t>(n * kMany)) != 0) ++differing;
     int t = n;
     while (t > 0 && count[t - 1] == n - t) --t;
     rows += n, entries += lnz, block += n - t;
@@ -104,5 +128,10 @@ int main(int argc, char** argv) {
   std::printf("  size: mean %.0f rows, %.0f entries of L, a dense block of %.0f\n", rows / k, entries / k, block / k);
   std::printf("  factorization: median %.1f us\n  solve:         median %.2f us\n", median(t_factor) * 1e6,
               median(t_solve) * 1e6);
+  std::printf("  six right-hand sides: one by one median %.2f us, at once (solveMany) %.2f us: %.2fx; %d of %zu"
+              " systems differ in a bit\n",
+              median(t_six_singly) * 1e6, median(t_six_at_once) * 1e6, median(t_six_singly) / median(t_six_at_once),
+              differing, t_six_at_once.size());
+  if (differing) return 1;
   return 0;
 }

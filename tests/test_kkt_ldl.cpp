@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <random>
 
 #include <Eigen/Dense>
@@ -120,6 +121,45 @@ TEST(KktLdl, SolvesIpoptsAugmentedSystemsWithTheirInertia) {
       EXPECT_GE(fullTrailingColumns(f), (nx + mc) * 3 / 4) << "seed " << seed;
     }
   }
+}
+
+// Several right-hand sides at once (solveMany, what Ipopt's blocks of
+// L-BFGS vectors get): each solution is solve()'s, bit for bit, for every
+// block size up to two groups and more, on systems with and without a dense
+// trailing block (its backward sums of every length, each residue mod 4),
+// and with sparse variables left of it.
+TEST(KktLdl, SolvesSeveralRightHandSidesAtOnceBitForBit) {
+  struct Shape {
+    int nx, mc, md;
+    double density;
+  };
+  int with_dense = 0, without_dense = 0;
+  for (const Shape& sh : {Shape{12, 4, 9, 0.3}, Shape{5, 2, 4, 0.3}, Shape{90, 30, 140, 0.3},
+                          Shape{90, 30, 140, 0.02}, Shape{37, 11, 50, 0.15}}) {
+    const Kkt k = makeKkt(sh.nx, sh.mc, sh.md, 7 + sh.nx, 0, 0, sh.density);
+    const Factors f = factorize(k);
+    ASSERT_EQ(f.status, 0) << "nx " << sh.nx;
+    (fullTrailingColumns(f) >= 8 ? with_dense : without_dense)++;
+    std::mt19937 rng(sh.nx);
+    std::uniform_real_distribution<double> u(-3, 3);
+    for (int nrhs = 1; nrhs <= 2 * acyclic::kkt::kMaxSolvedAtOnce + 3; ++nrhs) {
+      Eigen::MatrixXd B(k.n, nrhs);
+      for (int c = 0; c < nrhs; ++c)
+        for (int i = 0; i < k.n; ++i) B(i, c) = u(rng);
+      Eigen::MatrixXd X = B;
+      std::vector<double> work(static_cast<std::size_t>(k.n) * acyclic::kkt::kMaxSolvedAtOnce);
+      acyclic::kkt::solveMany(k.n, nrhs, f.perm.data(), f.Lp.data(), f.Li.data(), f.Lx.data(), f.D.data(), X.data(),
+                              work.data());
+      for (int c = 0; c < nrhs; ++c) {
+        const Eigen::VectorXd one = solveWith(f, B.col(c));
+        ASSERT_EQ(0, std::memcmp(one.data(), X.col(c).data(), sizeof(double) * k.n))
+            << "nx " << sh.nx << ", " << nrhs << " at once, vector " << c << ": largest difference "
+            << (one - X.col(c)).cwiseAbs().maxCoeff();
+      }
+    }
+  }
+  EXPECT_GT(with_dense, 0);
+  EXPECT_GT(without_dense, 0);
 }
 
 // Sparser Jacobians (a posture problem's forces touch few rows) leave some

@@ -726,7 +726,8 @@ TEST(PostureGenerator, TwoGeneratorsOnTwoThreadsAgreeWithOne) {
 // libacyclic_ipopt_interposers.so must be the definition the process uses
 // for the MUMPS entry points it replaces: dmumps_c (the lock) and the
 // per-call memory-save estimate (a fifth of a solve's CPU,
-// planner/posture/mumps_lock.cpp), and for Ipopt's clock (ipopt_clock.cpp).
+// planner/posture/mumps_lock.cpp), for Ipopt's clock (ipopt_clock.cpp), and
+// for its MA27 interface's Backsolve (ipopt_backsolve.cpp).
 // A link order that puts libdmumps_seq or libipopt first would silently lose them.
 namespace {
 // The file of the shared object that the process's lookup of `symbol` finds,
@@ -741,7 +742,7 @@ std::string libraryDefining(const char* symbol) {
 
 TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
   for (const char* name : {"dmumps_c", "__dmumps_save_restore_MOD_dmumps_compute_memory_save", "_ZN5Ipopt7CpuTimeEv",
-                           "_ZN5Ipopt7SysTimeEv"}) {
+                           "_ZN5Ipopt7SysTimeEv", "_ZN5Ipopt20Ma27TSolverInterface9BacksolveEiPd"}) {
     const std::string lib = libraryDefining(name);
     EXPECT_NE(lib.find("acyclic_ipopt_interposers"), std::string::npos) << name << " resolves to '" << lib << "'";
   }
@@ -755,6 +756,19 @@ TEST(PostureGenerator, MumpsInterposersAreTheOnesInUse) {
   o.linear_solver = "mumps";
   PostureGenerator pg(sc.robot, sc.scene, o);
   EXPECT_TRUE(pg.solve(r).success());
+  // With kkt_ldl and L-BFGS under Sherman-Morrison (the planner's), the
+  // update's blocks of right-hand sides reach it whole, through the Backsolve
+  // interposer (ipopt_backsolve.cpp); their solutions are bit for bit those
+  // of one at a time (KktLdl.SolvesSeveralRightHandSidesAtOnceBitForBit).
+  PostureGeneratorOptions sherman_morrison;
+  sherman_morrison.lbfgs_in_kkt = false;
+  PostureGenerator ldl(sc.robot, sc.scene, sherman_morrison);
+  r.initial_guess = perturbed(sc.start, rng, 0.15, 0.1);  // far enough for L-BFGS to gather its pairs
+  const long before = acyclic::kkt::rightHandSidesSolvedTogether();
+  const PostureResult res = ldl.solve(r);
+  EXPECT_TRUE(res.success());
+  EXPECT_GT(res.iterations, 10);
+  EXPECT_GT(acyclic::kkt::rightHandSidesSolvedTogether(), before);
 }
 
 // Postures along every third stance of the chair plan, walked in small steps

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "planner/posture/kkt_ldl.h"
+#include "planner/posture/pending_solves.h"
 
 extern "C" {
 typedef void (*ma27ad_t)(int* N, int* NZ, const int* IRN, const int* ICN, int* IW, int* LIW, int* IKEEP, int* IW1,
@@ -33,6 +34,7 @@ namespace acyclic::kkt {
 namespace {
 
 std::atomic<MatrixObserver> observer{nullptr};
+std::atomic<long> solved_together{0};
 
 // MA27's INFO(1) codes that Ipopt's interface acts on.
 constexpr int kOk = 0, kFatal = -1, kIwTooSmall = -3, kATooSmall = -4, kSingular = 3;
@@ -93,15 +95,34 @@ void factorEntry(int* N, int* NZ, const int* IRN, const int* ICN, double* A, int
   INFO[14] = negative;
 }
 
+// MA27CD: one right-hand side. Inside a block of them (Backsolve's loop,
+// ipopt_backsolve.cpp) the first call solves the whole block at once and
+// the others find theirs solved; the loop hands them in order, each n after
+// the previous one, and reads none before it has called MA27CD for all.
 void solveEntry(int* N, double* A, int*, int* IW, int*, double* W, int*, double* RHS, int*, int*, int*, double*) {
   const int n = *N;
   const int* Lp = IW + n;
+  acyclic_pending_solves* block = acyclic_pending_solves_of_thread();
+  if (block->nrhs > 1) {
+    const long offset = RHS - block->rhs;
+    if (offset == 0 && !block->solved) {
+      thread_local std::vector<double> work;
+      work.resize(static_cast<std::size_t>(n) * kMaxSolvedAtOnce);
+      solveMany(n, block->nrhs, IW, Lp, Lp + n + 1, A + n, A, RHS, work.data());
+      block->solved = 1;
+      solved_together.fetch_add(block->nrhs, std::memory_order_relaxed);
+      return;
+    }
+    if (block->solved && offset > 0 && offset % n == 0 && offset / n < block->nrhs) return;
+  }
   solve(n, IW, Lp, Lp + n + 1, A + n, A, RHS, W);
 }
 
 }  // namespace
 
 void observeFactorizations(MatrixObserver o) { observer.store(o); }
+
+long rightHandSidesSolvedTogether() { return solved_together.load(); }
 
 void registerWithIpopt() {
   static std::once_flag once;

@@ -445,4 +445,116 @@ ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const in
   for (int k = 0; k < n; ++k) b[perm[k]] = work[k];
 }
 
+namespace {
+
+// The dot product l . w of `solve`'s dense backward sweep, for R right-hand
+// sides at once: w holds R interleaved vectors (w[q * R + r]). Each one's
+// sum is formed in the order Eigen 3.4's dot forms it for two unaligned
+// maps of doubles with SSE2 packets (Redux.h, LinearVectorizedTraversal):
+// two accumulators of two lanes over the first multiple of 4, then one
+// more pair, the lanes added, then the last element. So each vector's
+// result is the one `solve` gets, bit for bit (tested for every length),
+// while the R sums run side by side.
+template <int R>
+__attribute__((always_inline)) inline void eigenOrderDots(const double* __restrict l, const double* __restrict w, int len, double* __restrict out) {
+  if (len == 0) {
+    for (int r = 0; r < R; ++r) out[r] = 0.0;
+    return;
+  }
+  const int size2 = (len / 4) * 4, size1 = (len / 2) * 2;
+  if (size1 == 0) {
+    for (int r = 0; r < R; ++r) out[r] = l[0] * w[r];
+    return;
+  }
+  double a0[R], a1[R], b0[R], b1[R];
+  for (int r = 0; r < R; ++r) a0[r] = l[0] * w[r], a1[r] = l[1] * w[R + r];
+  if (size1 > 2) {
+    for (int r = 0; r < R; ++r) b0[r] = l[2] * w[2 * R + r], b1[r] = l[3] * w[3 * R + r];
+    for (int i = 4; i < size2; i += 4)
+      for (int r = 0; r < R; ++r) {
+        a0[r] = a0[r] + l[i] * w[i * R + r];
+        a1[r] = a1[r] + l[i + 1] * w[(i + 1) * R + r];
+        b0[r] = b0[r] + l[i + 2] * w[(i + 2) * R + r];
+        b1[r] = b1[r] + l[i + 3] * w[(i + 3) * R + r];
+      }
+    for (int r = 0; r < R; ++r) a0[r] = a0[r] + b0[r], a1[r] = a1[r] + b1[r];
+    if (size1 > size2)
+      for (int r = 0; r < R; ++r) {
+        a0[r] = a0[r] + l[size2] * w[size2 * R + r];
+        a1[r] = a1[r] + l[size2 + 1] * w[(size2 + 1) * R + r];
+      }
+  }
+  for (int r = 0; r < R; ++r) out[r] = a0[r] + a1[r];
+  if (size1 < len)
+    for (int r = 0; r < R; ++r) out[r] = out[r] + l[len - 1] * w[(len - 1) * R + r];
+}
+
+// `solve` for R right-hand sides b + r * n, r < R, with every one's
+// arithmetic in solve's order (the same results bit for bit) but the R
+// vectors interleaved in work (work[i * R + r], n * R of it): each entry of
+// L is read once for all R, and the backward sweeps' sums, a chain of
+// dependent additions per vector, run R side by side.
+template <int R>
+__attribute__((always_inline)) inline void solveInterleaved(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
+                      double* b, double* __restrict work) {
+  const int t = denseStart(n, [Lp](int c) { return Lp[c + 1] - Lp[c]; });
+  for (int k = 0; k < n; ++k)
+    for (int r = 0; r < R; ++r) work[k * R + r] = b[r * n + perm[k]];
+  double x[R];
+  for (int j = 0; j < t; ++j) {
+    for (int r = 0; r < R; ++r) x[r] = work[j * R + r];
+    for (int p = Lp[j]; p < Lp[j + 1]; ++p) {
+      double* __restrict w = work + Li[p] * R;
+      const double l = Lx[p];
+      for (int r = 0; r < R; ++r) w[r] -= l * x[r];
+    }
+  }
+  for (int j = t; j < n; ++j) {
+    const int len = n - 1 - j;
+    for (int r = 0; r < R; ++r) x[r] = work[j * R + r];
+    double* __restrict w = work + (j + 1) * R;
+    const double* __restrict l = Lx + Lp[j];
+    for (int q = 0; q < len; ++q)
+      for (int r = 0; r < R; ++r) w[q * R + r] -= l[q] * x[r];
+  }
+  for (int j = 0; j < n; ++j)
+    for (int r = 0; r < R; ++r) work[j * R + r] /= D[j];
+  for (int j = n - 1; j >= t; --j) {
+    eigenOrderDots<R>(Lx + Lp[j], work + (j + 1) * R, n - 1 - j, x);
+    for (int r = 0; r < R; ++r) work[j * R + r] -= x[r];
+  }
+  for (int j = t - 1; j >= 0; --j) {
+    for (int r = 0; r < R; ++r) x[r] = work[j * R + r];
+    for (int p = Lp[j]; p < Lp[j + 1]; ++p) {
+      const double* __restrict w = work + Li[p] * R;
+      const double l = Lx[p];
+      for (int r = 0; r < R; ++r) x[r] -= l * w[r];
+    }
+    for (int r = 0; r < R; ++r) work[j * R + r] = x[r];
+  }
+  for (int k = 0; k < n; ++k)
+    for (int r = 0; r < R; ++r) b[r * n + perm[k]] = work[k * R + r];
+}
+
+}  // namespace
+
+ACYCLIC_VECTOR_CLONES void solveMany(int n, int nrhs, const int* perm, const int* Lp, const int* Li, const double* Lx,
+                                     const double* D, double* b, double* work) {
+  // In groups of at most kMaxSolvedAtOnce (bench_kkt: six at once 1.9 times
+  // as fast as one by one; four at once, 1.5 times).
+  for (int done = 0; done < nrhs;) {
+    double* bg = b + static_cast<long>(done) * n;
+    switch (std::min(nrhs - done, kMaxSolvedAtOnce)) {
+      case 1: solve(n, perm, Lp, Li, Lx, D, bg, work), done += 1; break;
+      case 2: solveInterleaved<2>(n, perm, Lp, Li, Lx, D, bg, work), done += 2; break;
+      case 3: solveInterleaved<3>(n, perm, Lp, Li, Lx, D, bg, work), done += 3; break;
+      case 4: solveInterleaved<4>(n, perm, Lp, Li, Lx, D, bg, work), done += 4; break;
+      case 5: solveInterleaved<5>(n, perm, Lp, Li, Lx, D, bg, work), done += 5; break;
+      case 6: solveInterleaved<6>(n, perm, Lp, Li, Lx, D, bg, work), done += 6; break;
+      case 7: solveInterleaved<7>(n, perm, Lp, Li, Lx, D, bg, work), done += 7; break;
+      default: solveInterleaved<8>(n, perm, Lp, Li, Lx, D, bg, work), done += 8; break;
+    }
+  }
+}
+
 }  // namespace acyclic::kkt

@@ -57,6 +57,15 @@ int factor(int n, int nz, const int* irn, const int* jcn, const double* a, const
 void solve(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D, double* b,
            double* work);
 
+// Solves A x = b for nrhs right-hand sides b + r * n (r < nrhs) in place,
+// each to the same result as solve() gives it, bit for bit, but faster than
+// one by one (each entry of L is read once for several of them);
+// work[n * kMaxSolvedAtOnce] is scratch. Ipopt asks for several at once with L-BFGS (the low-rank
+// update's vectors, six with its default history): ipopt_ldl.cpp.
+constexpr int kMaxSolvedAtOnce = 8;
+void solveMany(int n, int nrhs, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
+               double* b, double* work);
+
 // Registers this factorization with Ipopt as its linear solver "ma27"
 // (through LSL_setMA27, the loader's way to supply the routines). Call before
 // an IpoptApplication initializes; idempotent and thread-safe. The options
@@ -68,6 +77,11 @@ void registerWithIpopt();
 // benchmark that times the factorization on real systems (bench/bench_kkt).
 // nullptr: none (the default). Process-wide; the call is on the solving
 // thread.
+// Right-hand sides that Ipopt's solves have had solved in blocks (solveMany,
+// through ipopt_backsolve.cpp) since the process began: a test's way to see
+// that the interposer is in use.
+long rightHandSidesSolvedTogether();
+
 using MatrixObserver = void (*)(int n, int nz, const int* irn, const int* jcn, const double* a);
 void observeFactorizations(MatrixObserver observer);
 
