@@ -8,11 +8,7 @@
 // block solves all of it at once (kkt::solveMany, the same results bit for
 // bit) and the others find theirs done. Nothing about Ipopt's object is
 // read: it is passed through.
-#include <dlfcn.h>
-
-#include <cstdio>
-#include <cstdlib>
-
+#include "planner/posture/next_definition.h"
 #include "planner/posture/pending_solves.h"
 
 namespace {
@@ -22,14 +18,8 @@ constexpr const char* kBacksolve = "_ZN5Ipopt20Ma27TSolverInterface9BacksolveEiP
 using BacksolveFn = int (*)(void*, int, double*);
 
 BacksolveFn realBacksolve() {
-  static BacksolveFn fn = [] {
-    auto f = reinterpret_cast<BacksolveFn>(dlsym(RTLD_NEXT, kBacksolve));
-    if (!f) {
-      std::fprintf(stderr, "acyclic: Ipopt's Ma27TSolverInterface::Backsolve not found behind its interposer\n");
-      std::abort();
-    }
-    return f;
-  }();
+  static const BacksolveFn fn =
+      acyclic::nextDefinition<BacksolveFn>(kBacksolve, "Ipopt's Ma27TSolverInterface::Backsolve");
   return fn;
 }
 }  // namespace

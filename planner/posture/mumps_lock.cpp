@@ -14,11 +14,9 @@
 // bench_posture: about 20% of all CPU. The figure only fills RINFO(7:8) and
 // RINFOG(17:18), which Ipopt never reads and no save ever uses here. The
 // call goes through libdmumps_seq's PLT, so a definition here wins.
-#include <dlfcn.h>
-
-#include <cstdio>
-#include <cstdlib>
 #include <mutex>
+
+#include "planner/posture/next_definition.h"
 
 namespace {
 std::mutex& mumpsMutex() {
@@ -27,14 +25,7 @@ std::mutex& mumpsMutex() {
 }
 using DmumpsFn = void (*)(void*);
 DmumpsFn realDmumps() {
-  static DmumpsFn fn = [] {
-    auto f = reinterpret_cast<DmumpsFn>(dlsym(RTLD_NEXT, "dmumps_c"));
-    if (!f) {
-      std::fprintf(stderr, "acyclic: dmumps_c not found behind the MUMPS lock\n");
-      std::abort();
-    }
-    return f;
-  }();
+  static const DmumpsFn fn = acyclic::nextDefinition<DmumpsFn>("dmumps_c", "dmumps_c (the MUMPS lock's)");
   return fn;
 }
 }  // namespace
