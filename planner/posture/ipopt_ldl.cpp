@@ -35,6 +35,7 @@ namespace {
 
 std::atomic<MatrixObserver> observer{nullptr};
 std::atomic<long> solved_together{0};
+std::atomic<bool> blocks_at_once{true};
 
 // MA27's INFO(1) codes that Ipopt's interface acts on.
 constexpr int kOk = 0, kFatal = -1, kIwTooSmall = -3, kATooSmall = -4, kSingular = 3;
@@ -103,7 +104,7 @@ void solveEntry(int* N, double* A, int*, int* IW, int*, double* W, int*, double*
   const int n = *N;
   const int* Lp = IW + n;
   acyclic_pending_solves* block = acyclic_pending_solves_of_thread();
-  if (block->nrhs > 1) {
+  if (block->nrhs > 1 && blocks_at_once.load(std::memory_order_relaxed)) {
     const long offset = RHS - block->rhs;
     if (offset == 0 && !block->solved) {
       thread_local std::vector<double> work;
@@ -123,6 +124,8 @@ void solveEntry(int* N, double* A, int*, int* IW, int*, double* W, int*, double*
 void observeFactorizations(MatrixObserver o) { observer.store(o); }
 
 long rightHandSidesSolvedTogether() { return solved_together.load(); }
+
+void solveBlocksAtOnce(bool at_once) { blocks_at_once.store(at_once); }
 
 void registerWithIpopt() {
   static std::once_flag once;

@@ -120,6 +120,49 @@ inline bool consecutiveRows(const int* Li, int begin, int end) {
   return end - begin >= 2 && Li[end - 1] - Li[begin] == end - begin - 1;
 }
 
+// The dot products l . w of the dense backward sweep, for R right-hand
+// sides at once: w holds R interleaved vectors (w[q * R + r]; R = 1: one
+// vector). Each sum is formed in the order Eigen 3.4's dot() forms it for
+// doubles with SSE2 packets (Redux.h, LinearVectorizedTraversal), which
+// solve() called before this: two accumulators of two lanes over the first
+// multiple of 4, then one more pair, the lanes added, then the last
+// element. So the factorization's results did not change when solve() came
+// to use it, and they no longer depend on Eigen's version or vector width.
+// The R sums run side by side.
+template <int R>
+__attribute__((always_inline)) inline void eigenOrderDots(const double* __restrict l, const double* __restrict w, int len, double* __restrict out) {
+  if (len == 0) {
+    for (int r = 0; r < R; ++r) out[r] = 0.0;
+    return;
+  }
+  const int size2 = (len / 4) * 4, size1 = (len / 2) * 2;
+  if (size1 == 0) {
+    for (int r = 0; r < R; ++r) out[r] = l[0] * w[r];
+    return;
+  }
+  double a0[R], a1[R], b0[R], b1[R];
+  for (int r = 0; r < R; ++r) a0[r] = l[0] * w[r], a1[r] = l[1] * w[R + r];
+  if (size1 > 2) {
+    for (int r = 0; r < R; ++r) b0[r] = l[2] * w[2 * R + r], b1[r] = l[3] * w[3 * R + r];
+    for (int i = 4; i < size2; i += 4)
+      for (int r = 0; r < R; ++r) {
+        a0[r] = a0[r] + l[i] * w[i * R + r];
+        a1[r] = a1[r] + l[i + 1] * w[(i + 1) * R + r];
+        b0[r] = b0[r] + l[i + 2] * w[(i + 2) * R + r];
+        b1[r] = b1[r] + l[i + 3] * w[(i + 3) * R + r];
+      }
+    for (int r = 0; r < R; ++r) a0[r] = a0[r] + b0[r], a1[r] = a1[r] + b1[r];
+    if (size1 > size2)
+      for (int r = 0; r < R; ++r) {
+        a0[r] = a0[r] + l[size2] * w[size2 * R + r];
+        a1[r] = a1[r] + l[size2 + 1] * w[(size2 + 1) * R + r];
+      }
+  }
+  for (int r = 0; r < R; ++r) out[r] = a0[r] + a1[r];
+  if (size1 < len)
+    for (int r = 0; r < R; ++r) out[r] = out[r] + l[len - 1] * w[(len - 1) * R + r];
+}
+
 }  // namespace
 
 long analyse(int n, int nz, const int* irn, const int* jcn, int* perm, int* parent, int* colcount, std::string* why) {
@@ -435,7 +478,9 @@ ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const in
   for (int j = 0; j < n; ++j) work[j] /= D[j];
   for (int j = n - 1; j >= t; --j) {
     const int len = n - 1 - j;
-    work[j] -= Eigen::Map<const Eigen::VectorXd>(Lx + Lp[j], len).dot(Eigen::Map<const Eigen::VectorXd>(work + j + 1, len));
+    double dot;
+    eigenOrderDots<1>(Lx + Lp[j], work + j + 1, len, &dot);
+    work[j] -= dot;
   }
   for (int j = t - 1; j >= 0; --j) {
     double xj = work[j];
@@ -446,48 +491,6 @@ ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const in
 }
 
 namespace {
-
-// The dot product l . w of `solve`'s dense backward sweep, for R right-hand
-// sides at once: w holds R interleaved vectors (w[q * R + r]). Each one's
-// sum is formed in the order Eigen 3.4's dot forms it for two unaligned
-// maps of doubles with SSE2 packets (Redux.h, LinearVectorizedTraversal):
-// two accumulators of two lanes over the first multiple of 4, then one
-// more pair, the lanes added, then the last element. So each vector's
-// result is the one `solve` gets, bit for bit (tested for every length),
-// while the R sums run side by side.
-template <int R>
-__attribute__((always_inline)) inline void eigenOrderDots(const double* __restrict l, const double* __restrict w, int len, double* __restrict out) {
-  if (len == 0) {
-    for (int r = 0; r < R; ++r) out[r] = 0.0;
-    return;
-  }
-  const int size2 = (len / 4) * 4, size1 = (len / 2) * 2;
-  if (size1 == 0) {
-    for (int r = 0; r < R; ++r) out[r] = l[0] * w[r];
-    return;
-  }
-  double a0[R], a1[R], b0[R], b1[R];
-  for (int r = 0; r < R; ++r) a0[r] = l[0] * w[r], a1[r] = l[1] * w[R + r];
-  if (size1 > 2) {
-    for (int r = 0; r < R; ++r) b0[r] = l[2] * w[2 * R + r], b1[r] = l[3] * w[3 * R + r];
-    for (int i = 4; i < size2; i += 4)
-      for (int r = 0; r < R; ++r) {
-        a0[r] = a0[r] + l[i] * w[i * R + r];
-        a1[r] = a1[r] + l[i + 1] * w[(i + 1) * R + r];
-        b0[r] = b0[r] + l[i + 2] * w[(i + 2) * R + r];
-        b1[r] = b1[r] + l[i + 3] * w[(i + 3) * R + r];
-      }
-    for (int r = 0; r < R; ++r) a0[r] = a0[r] + b0[r], a1[r] = a1[r] + b1[r];
-    if (size1 > size2)
-      for (int r = 0; r < R; ++r) {
-        a0[r] = a0[r] + l[size2] * w[size2 * R + r];
-        a1[r] = a1[r] + l[size2 + 1] * w[(size2 + 1) * R + r];
-      }
-  }
-  for (int r = 0; r < R; ++r) out[r] = a0[r] + a1[r];
-  if (size1 < len)
-    for (int r = 0; r < R; ++r) out[r] = out[r] + l[len - 1] * w[(len - 1) * R + r];
-}
 
 // `solve` for R right-hand sides b + r * n, r < R, with every one's
 // arithmetic in solve's order (the same results bit for bit) but the R
@@ -540,8 +543,8 @@ __attribute__((always_inline)) inline void solveInterleaved(int n, const int* pe
 
 ACYCLIC_VECTOR_CLONES void solveMany(int n, int nrhs, const int* perm, const int* Lp, const int* Li, const double* Lx,
                                      const double* D, double* b, double* work) {
-  // In groups of at most kMaxSolvedAtOnce (bench_kkt: six at once 1.9 times
-  // as fast as one by one; four at once, 1.5 times).
+  // In groups of at most kMaxSolvedAtOnce (bench_kkt: six at once about
+  // twice as fast as one by one; in groups of four, 1.5 times).
   for (int done = 0; done < nrhs;) {
     double* bg = b + static_cast<long>(done) * n;
     switch (std::min(nrhs - done, kMaxSolvedAtOnce)) {

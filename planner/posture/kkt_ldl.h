@@ -60,8 +60,9 @@ void solve(int n, const int* perm, const int* Lp, const int* Li, const double* L
 // Solves A x = b for nrhs right-hand sides b + r * n (r < nrhs) in place,
 // each to the same result as solve() gives it, bit for bit, but faster than
 // one by one (each entry of L is read once for several of them);
-// work[n * kMaxSolvedAtOnce] is scratch. Ipopt asks for several at once with L-BFGS (the low-rank
-// update's vectors, six with its default history): ipopt_ldl.cpp.
+// work[n * kMaxSolvedAtOnce] is scratch. Ipopt asks for several at once
+// with L-BFGS (the low-rank update's vectors, six with its default
+// history): ipopt_ldl.cpp.
 constexpr int kMaxSolvedAtOnce = 8;
 void solveMany(int n, int nrhs, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
                double* b, double* work);
@@ -77,12 +78,17 @@ void registerWithIpopt();
 // benchmark that times the factorization on real systems (bench/bench_kkt).
 // nullptr: none (the default). Process-wide; the call is on the solving
 // thread.
-// Right-hand sides that Ipopt's solves have had solved in blocks (solveMany,
-// through ipopt_backsolve.cpp) since the process began: a test's way to see
-// that the interposer is in use.
-long rightHandSidesSolvedTogether();
-
 using MatrixObserver = void (*)(int n, int nz, const int* irn, const int* jcn, const double* a);
 void observeFactorizations(MatrixObserver observer);
+
+// Whether the blocks of right-hand sides Ipopt's MA27 interface solves
+// (ipopt_backsolve.cpp) go to solveMany at once (true, the default) or to
+// solve() one by one: the same results either way; for a test that says
+// so, and a benchmark. Process-wide.
+void solveBlocksAtOnce(bool at_once);
+
+// Right-hand sides that Ipopt's solves have had solved in blocks (solveMany)
+// since the process began: a test's way to see that the interposer is in use.
+long rightHandSidesSolvedTogether();
 
 }  // namespace acyclic::kkt
