@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -108,11 +109,18 @@ void solveEntry(int* N, double* A, int*, int* IW, int*, double* W, int*, double*
     const long offset = RHS - block->rhs;
     if (offset == 0 && !block->solved) {
       thread_local std::vector<double> work;
-      work.resize(static_cast<std::size_t>(n) * kMaxSolvedAtOnce);
-      solveMany(n, block->nrhs, IW, Lp, Lp + n + 1, A + n, A, RHS, work.data());
-      block->solved = 1;
-      solved_together.fetch_add(block->nrhs, std::memory_order_relaxed);
-      return;
+      bool have_work = true;
+      try {  // nothing may throw through Ipopt's C loader: without scratch, one by one
+        work.resize(static_cast<std::size_t>(n) * kMaxSolvedAtOnce);
+      } catch (const std::bad_alloc&) {
+        have_work = false;
+      }
+      if (have_work) {
+        solveMany(n, block->nrhs, IW, Lp, Lp + n + 1, A + n, A, RHS, work.data());
+        block->solved = 1;
+        solved_together.fetch_add(block->nrhs, std::memory_order_relaxed);
+        return;
+      }
     }
     if (block->solved && offset > 0 && offset % n == 0 && offset / n < block->nrhs) return;
   }
