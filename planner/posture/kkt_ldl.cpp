@@ -130,7 +130,8 @@ inline bool consecutiveRows(const int* Li, int begin, int end) {
 // to use it, and they no longer depend on Eigen's version or vector width.
 // The R sums run side by side.
 template <int R>
-__attribute__((always_inline)) inline void eigenOrderDots(const double* __restrict l, const double* __restrict w, int len, double* __restrict out) {
+__attribute__((always_inline)) inline void eigenOrderDots(const double* __restrict l, const double* __restrict w,
+                                                          int len, double* __restrict out) {
   if (len == 0) {
     for (int r = 0; r < R; ++r) out[r] = 0.0;
     return;
@@ -498,8 +499,9 @@ namespace {
 // L is read once for all R, and the backward sweeps' sums, a chain of
 // dependent additions per vector, run R side by side.
 template <int R>
-__attribute__((always_inline)) inline void solveInterleaved(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
-                      double* b, double* __restrict work) {
+__attribute__((always_inline)) inline void solveInterleaved(int n, const int* perm, const int* Lp, const int* Li,
+                                                            const double* Lx, const double* D, double* b,
+                                                            double* __restrict work) {
   const int t = denseStart(n, [Lp](int c) { return Lp[c + 1] - Lp[c]; });
   for (int k = 0; k < n; ++k)
     for (int r = 0; r < R; ++r) work[k * R + r] = b[r * n + perm[k]];
