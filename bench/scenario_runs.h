@@ -62,7 +62,7 @@ struct PlannerOverrides {
   // --member, a bad scenario): false, with the reason on stderr, if not.
   bool acceptedBy(const std::vector<std::string>& paths, const char* bench) const {
     try {
-      for (const auto& path : paths) parameters(Scenario::load(path));
+      for (const auto& path : paths) settings(Scenario::load(path));
       return true;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "%s: %s\n", bench, e.what());
@@ -70,15 +70,20 @@ struct PlannerOverrides {
     }
   }
 
-  // The scenario's parameters with these changes, and a verifier when they
-  // verify transitions.
-  PlannerParameters parameters(const Scenario& sc) const {
+  // The scenario's parameters with these changes, without a verifier.
+  PlannerParameters settings(const Scenario& sc) const {
     PlannerParameters p = plannerParameters(sc);
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (max_nodes > 0) p.max_nodes = max_nodes;
     if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
     if (verify) p.verify_transitions = true;
     if (!member.empty()) keepPortfolioMember(p, member, sc.path);
+    return p;
+  }
+
+  // settings(), and a verifier when they verify transitions.
+  PlannerParameters parameters(const Scenario& sc) const {
+    PlannerParameters p = settings(sc);
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
     attachPlanVerifier(p, sc);
 #endif
