@@ -603,6 +603,56 @@ TEST(PostureGenerator, StopAtRestorationGivesUpEarlierAndKeepsWhatIsReachable) {
   expectValid(sc, c, stance);
 }
 
+// The stop flag (the planner's chains of candidates, where a success makes
+// the candidates after it useless): a flag left down changes nothing; one
+// raised during the solve ends it at Ipopt's next iteration, as Stopped; one
+// raised before, at once, with no retry. The flag is raised here from the
+// KKT observer, on the solving thread at its fifth factorization, so that
+// where it stops does not depend on timing; the planner raises it from the
+// other generator's thread.
+namespace {
+std::atomic<int> factorizations{0};
+std::atomic<bool> stop_flag{false};
+void raiseStopAtTheFifth(int, int, const int*, const int*, const double*) {
+  if (++factorizations == 5) stop_flag = true;
+}
+}  // namespace
+
+TEST(PostureGenerator, AStopFlagEndsTheSolveAtTheNextIteration) {
+  const Scenario& sc = chair();
+  PostureGeneratorOptions o;
+  o.max_seconds = 1e6;  // bounded by iterations only
+  PostureGenerator pg(sc.robot, sc.scene, o);
+  const PostureRequest r = wristOnTable(sc);
+  const PostureResult plain = pg.solve(r);
+  ASSERT_TRUE(plain.success()) << plain.reason;
+  ASSERT_GT(plain.iterations, 10);  // long enough to stop in the middle
+
+  stop_flag = false;
+  const PostureResult down = pg.solve(r, &stop_flag);
+  ASSERT_TRUE(down.success()) << down.reason;
+  EXPECT_EQ(down.iterations, plain.iterations);
+  EXPECT_EQ(down.configuration.joints, plain.configuration.joints);
+  EXPECT_EQ(down.configuration.base_position, plain.configuration.base_position);
+
+  factorizations = 0;
+  acyclic::kkt::observeFactorizations(raiseStopAtTheFifth);
+  const PostureResult stopped = pg.solve(r, &stop_flag);
+  acyclic::kkt::observeFactorizations(nullptr);
+  EXPECT_EQ(stopped.status, PostureResult::Status::Stopped) << toString(stopped.status) << ": " << stopped.reason;
+  EXPECT_FALSE(stopped.reason.empty());
+  EXPECT_GE(stopped.iterations, 1);
+  EXPECT_LE(stopped.iterations, 5);  // at least one factorization per iteration: stopped by the sixth
+
+  PostureRequest with_retry = r;
+  with_retry.retry_guess = sc.start;
+  stop_flag = true;
+  const PostureResult at_once = pg.solve(with_retry, &stop_flag);
+  EXPECT_EQ(at_once.status, PostureResult::Status::Stopped);
+  EXPECT_EQ(at_once.iterations, 0);
+  EXPECT_EQ(at_once.solves, 1);
+}
+
 TEST(PostureGenerator, OneThighWithTheCenterOfMassFarOutsideFailsOnEquilibrium) {  // (e)
   const Scenario& sc = chair();
   PostureGenerator pg(sc.robot, sc.scene);

@@ -19,6 +19,7 @@ const char* toString(PostureResult::Status s) {
     case PostureResult::Status::IterationLimit: return "iteration limit";
     case PostureResult::Status::TimeLimit: return "time limit";
     case PostureResult::Status::BadInput: return "bad input";
+    case PostureResult::Status::Stopped: return "stopped";
   }
   return "?";
 }
@@ -106,6 +107,10 @@ class PostureTNLP : public Ipopt::TNLP {
                              Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
                              Ipopt::IpoptCalculatedQuantities*) override {
     iterations = iter;
+    if (stop && stop->load(std::memory_order_relaxed)) {
+      stopped = true;
+      return false;  // USER_REQUESTED_STOP
+    }
     if (stop_at_restoration && mode == Ipopt::RestorationPhaseMode) {
       entered_restoration = true;
       return false;  // Ipopt stops with USER_REQUESTED_STOP
@@ -123,6 +128,8 @@ class PostureTNLP : public Ipopt::TNLP {
   Ipopt::SolverReturn final_status = Ipopt::INTERNAL_ERROR;
   bool stop_at_restoration = false;
   bool entered_restoration = false;
+  const std::atomic<bool>* stop = nullptr;  // the caller's (PostureGenerator::solve)
+  bool stopped = false;
   Eigen::VectorXd x_final;
   double final_cost = 0;
   int iterations = 0;
@@ -213,20 +220,22 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
 
 PostureGenerator::~PostureGenerator() = default;
 
-PostureResult PostureGenerator::solve(const PostureRequest& request) {
-  PostureResult res = solveOnce(request);
-  if (res.success() || res.status == PostureResult::Status::BadInput || !request.retry_guess) return res;
+PostureResult PostureGenerator::solve(const PostureRequest& request, const std::atomic<bool>* stop) {
+  PostureResult res = solveOnce(request, stop);
+  if (res.success() || res.status == PostureResult::Status::BadInput ||
+      res.status == PostureResult::Status::Stopped || !request.retry_guess)
+    return res;
   PostureRequest again = request;
   again.initial_guess = *request.retry_guess;
   again.retry_guess.reset();
-  PostureResult second = solveOnce(again);
+  PostureResult second = solveOnce(again, stop);
   second.solves = 2;
   second.iterations += res.iterations;
   second.seconds += res.seconds;
   return second;
 }
 
-PostureResult PostureGenerator::solveOnce(const PostureRequest& request) {
+PostureResult PostureGenerator::solveOnce(const PostureRequest& request, const std::atomic<bool>* stop) {
   const auto t0 = std::chrono::steady_clock::now();
   PostureResult res;
   res.configuration = request.initial_guess;
@@ -248,6 +257,7 @@ PostureResult PostureGenerator::solveOnce(const PostureRequest& request) {
                                                    : PostureTNLP::Hessian::Diagonal;
     ::Ipopt::SmartPtr<PostureTNLP> nlp = new PostureTNLP(*problem, x0, kind);
     nlp->stop_at_restoration = opt_.stop_at_restoration;
+    nlp->stop = stop;
     const double budget = opt_.max_seconds - elapsed();
     if (budget <= 0) {
       res.status = PostureResult::Status::TimeLimit;
@@ -276,6 +286,11 @@ PostureResult PostureGenerator::solveOnce(const PostureRequest& request) {
         res.reason = "no feasible posture within the time limit";
         break;
       case ::Ipopt::USER_REQUESTED_STOP:
+        if (nlp->stopped) {
+          res.status = PostureResult::Status::Stopped;
+          res.reason = "stopped by its caller";
+          break;
+        }
         res.status = PostureResult::Status::Infeasible;
         res.reason = nlp->entered_restoration
                          ? "no step toward feasibility from the initial guess (the solver entered its restoration phase)"

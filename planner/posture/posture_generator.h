@@ -68,7 +68,8 @@ struct PostureGeneratorOptions {
 };
 
 struct PostureResult {
-  enum class Status { Success, Infeasible, IterationLimit, TimeLimit, BadInput };
+  // Stopped: the caller's stop flag ended the solve (its result no longer needed).
+  enum class Status { Success, Infeasible, IterationLimit, TimeLimit, BadInput, Stopped };
   Status status = Status::BadInput;
   std::string reason;                 // set on failure
   Configuration configuration;        // the witness posture (the last iterate on failure)
@@ -92,15 +93,18 @@ class PostureGenerator {
   PostureGenerator& operator=(const PostureGenerator&) = delete;
 
   // Solves one request (and again from its retry_guess when that fails).
-  // Not re-entrant: use one generator per thread.
-  PostureResult solve(const PostureRequest& request);
+  // Not re-entrant: use one generator per thread. `stop`, when given and
+  // raised (by another thread), ends the solve at Ipopt's next iteration
+  // with Status::Stopped: a search that no longer needs the result gets its
+  // generator back within one iteration instead of a whole call.
+  PostureResult solve(const PostureRequest& request, const std::atomic<bool>* stop = nullptr);
 
   const PostureGeneratorOptions& options() const { return opt_; }
   std::shared_ptr<const CollisionModel> collisionModel() const { return collision_; }
 
  private:
   struct Ipopt;
-  PostureResult solveOnce(const PostureRequest& request);
+  PostureResult solveOnce(const PostureRequest& request, const std::atomic<bool>* stop);
   std::shared_ptr<const RobotModel> robot_;
   std::shared_ptr<const Scene> scene_;
   std::shared_ptr<const CollisionModel> collision_;
