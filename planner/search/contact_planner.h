@@ -151,6 +151,9 @@ struct PlanningStats {
   long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
   long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
   long calls_ahead_unused = 0;  // solved ahead on an idle generator, their turn never came (not in posture_calls)
+  // Started ahead like those, and stopped within an iteration when the pair's
+  // candidate before them made its son (not in posture_calls either).
+  long calls_stopped = 0;
   // Of posture_calls, those made exporting plans found (witnesses of the
   // settled stances between a removal and an addition).
   long export_calls = 0;

@@ -25,6 +25,7 @@ PlanningStats combined(const std::vector<PlanningStats>& all) {
     s.check_refusals += m.check_refusals;
     s.pairs_remembered += m.pairs_remembered;
     s.calls_ahead_unused += m.calls_ahead_unused;
+    s.calls_stopped += m.calls_stopped;
     s.export_calls += m.export_calls;
     s.limb_retries += m.limb_retries;
     s.limb_retry_successes += m.limb_retry_successes;
