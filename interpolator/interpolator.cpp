@@ -59,6 +59,8 @@ std::string validateOptions(const InterpolatorOptions& o) {
     return "repair attempts, refinement depth and posture iterations must be non-negative, the repair step positive";
   if (!(o.wide_clearance >= 0 && o.wide_clearance < 0.05)) return "the wide clearance must be in [0, 0.05) m";
   if (o.threads < 1) return "threads must be at least 1";
+  if (o.posture_mu_oracle != "quality-function" && o.posture_mu_oracle != "probing" && o.posture_mu_oracle != "loqo")
+    return "the barrier oracle must be quality-function, probing or loqo, not '" + o.posture_mu_oracle + "'";
   return "";
 }
 
@@ -71,6 +73,7 @@ InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions 
   if (f.has("posture_support_inset_y")) o.support_inset_y = f["posture_support_inset_y"].number();
   if (f.has("posture_friction_share")) o.friction_share = f["posture_friction_share"].number();
   if (f.has("zmp_shift_cap")) o.zmp_shift_cap = f["zmp_shift_cap"].number();
+  if (f.has("transition_mu_oracle")) o.posture_mu_oracle = f["transition_mu_oracle"].string();
   return o;
 }
 
@@ -98,6 +101,7 @@ TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
   to.posture.problem.friction_share = opt.friction_share;
   to.posture.ipopt_options = opt.posture_ipopt_options;
   to.posture.lbfgs_in_kkt = opt.posture_lbfgs_in_kkt;
+  to.posture.mu_oracle = opt.posture_mu_oracle;
   to.timing = TimeLawOptions{opt.dt, opt.velocity_share, opt.speed_cap, opt.link_acceleration_cap};
   to.timing.zmp_shift_cap = opt.zmp_shift_cap;
   to.verify_samples = opt.verify_samples;

@@ -60,6 +60,12 @@ struct InterpolatorOptions {
   // L-BFGS's low-rank part inside the KKT system
   // (PostureGeneratorOptions::lbfgs_in_kkt).
   bool posture_lbfgs_in_kkt = true;
+  // Ipopt's barrier oracle for the knots' solves (PostureGeneratorOptions::
+  // mu_oracle): "quality-function" (Ipopt's default), "probing" or "loqo".
+  // A scenario's planner key transition_mu_oracle sets it (withScenarioMargins);
+  // on chair_paper's plans probing makes the same transitions in 0.76 to
+  // 0.81 of the time (docs/design.md section 10).
+  std::string posture_mu_oracle = "quality-function";
   // Transitions solved at once, one solver each (same result for any count).
   int threads = 2;
 };
@@ -105,9 +111,10 @@ const char* toString(InterpolationResult::Status s);
 // posture_support_inset, posture_support_inset_y and posture_friction_share,
 // and the time law's zmp_shift_cap) where it sets them: the knots between two
 // stances keep the margins the stances were planned with, and a scenario
-// whose single supports need a slow weight shift to execute says so. The
-// interpolator's command line and the plan verifier start from these; a
-// margin given on the command line wins.
+// whose single supports need a slow weight shift to execute says so. Also
+// its transition_mu_oracle, the knots' barrier oracle. The interpolator's
+// command line and the plan verifier start from these, so that a plan is
+// verified as it will be interpolated; a value given on the command line wins.
 InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions options);
 
 // The transition solver's options the interpolator uses for these options

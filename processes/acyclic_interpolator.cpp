@@ -70,6 +70,10 @@ int main(int argc, char** argv) {
                  "largest shift of the zero-moment point by the motion's accelerations, m (0: no such bound; 0.01 "
                  "slows a whole-body sway to about 0.12 m/s^2; default: the scenario's planner key zmp_shift_cap, "
                  "else 0)");
+  auto* mu_flag = app.add_option("--mu-oracle", o.posture_mu_oracle,
+                 "Ipopt's barrier oracle for the knots' posture solves: quality-function, probing or loqo (default: "
+                 "the scenario's planner key transition_mu_oracle, else quality-function)")
+                     ->check(CLI::IsMember({"quality-function", "probing", "loqo"}));
   app.add_option("--link-acceleration-cap", o.link_acceleration_cap,
                  "largest acceleration of any link origin, m/s^2 (joints: the robot file's acceleration_limits)")
       ->capture_default_str();
@@ -88,13 +92,15 @@ int main(int argc, char** argv) {
   o.filter = !no_filter;
   // The scenario's margins unless the command line gives them.
   const bool inset_given = inset_flag->count() > 0, inset_y_given = inset_y_flag->count() > 0,
-             share_given = share_flag->count() > 0, zmp_given = zmp_flag->count() > 0;
+             share_given = share_flag->count() > 0, zmp_given = zmp_flag->count() > 0,
+             mu_given = mu_flag->count() > 0;
   const acyclic::InterpolatorOptionsFor options_for = [=](const acyclic::Scenario& sc) {
     acyclic::InterpolatorOptions r = acyclic::withScenarioMargins(sc, o);
     if (inset_given) r.support_inset = o.support_inset;
     if (inset_y_given) r.support_inset_y = o.support_inset_y;
     if (share_given) r.friction_share = o.friction_share;
     if (zmp_given) r.zmp_shift_cap = o.zmp_shift_cap;
+    if (mu_given) r.posture_mu_oracle = o.posture_mu_oracle;
     return r;
   };
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h

@@ -1167,15 +1167,19 @@ TEST(InterpolatorProcess, WritesATrajectoryThatAcyclicCheckAccepts) {
 // scenario's 6 cm inset gives the trajectory that --support-inset 0.06
 // gives, and moves the single supports' centre of mass away from where no
 // margin leaves it; --support-inset 0 on the command line wins. The same for
-// the time law's ZMP shift cap.
+// the time law's ZMP shift cap, and the knots' barrier oracle.
 TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem) {
   const Scenario& sc = floorScenario();
   test::TempDir dir;
   const std::string scenario =
       dir.write("margins.yaml", test::scenarioText("models/scenarios/step_forward.yaml") +
-                                    "planner: {posture_support_inset: 0.06, posture_friction_share: 0.5, zmp_shift_cap: 0.004}\n");
+                                    "planner: {posture_support_inset: 0.06, posture_friction_share: 0.5, zmp_shift_cap: 0.004, "
+                                    "transition_mu_oracle: probing}\n");
   const Scenario with = Scenario::load(scenario);
   const InterpolatorOptions o = withScenarioMargins(with, {});
+  EXPECT_EQ(o.posture_mu_oracle, "probing");
+  EXPECT_EQ(withScenarioMargins(sc, {}).posture_mu_oracle, "quality-function");
+  EXPECT_EQ(transitionOptions(o).posture.mu_oracle, "probing");
   EXPECT_DOUBLE_EQ(o.zmp_shift_cap, 0.004);
   EXPECT_DOUBLE_EQ(o.support_inset, 0.06);
   EXPECT_DOUBLE_EQ(o.friction_share, 0.5);
@@ -1205,6 +1209,17 @@ TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem)
   // The scenario's ZMP shift cap slows the weight shifts; 0 on the command line lifts it.
   const Trajectory uncapped = run("d.json", "--zmp-shift-cap 0");
   EXPECT_GT(by_scenario.duration(), uncapped.duration() + 0.1);
+  // The scenario's oracle (probing) makes other knots than Ipopt's default,
+  // which the command line brings back.
+  const Trajectory default_oracle = run("e.json", "--mu-oracle quality-function");
+  bool differ = default_oracle.samples.size() != by_scenario.samples.size();
+  for (std::size_t k = 0; !differ && k < by_scenario.samples.size(); ++k)
+    differ = by_scenario.samples[k].q.joints != default_oracle.samples[k].q.joints;
+  EXPECT_TRUE(differ);
+  const auto bad = test::runProcess(test::binaryPath("processes/acyclic-interpolator") + " --scenario " + scenario +
+                                    " --in " + plan + " --out " + dir.path() + "/f.json --mu-oracle fast");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--mu-oracle"), std::string::npos) << bad.output;
 }
 
 TEST(InterpolatorProcess, HelpAndBadInput) {

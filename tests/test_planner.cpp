@@ -396,6 +396,8 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
            {"planner: {posture_pyramid_edges: 6}\n", "planner.posture_pyramid_edges"},
            {"planner: {posture_support_inset: -0.01}\n", "planner.posture_support_inset"},
            {"planner: {zmp_shift_cap: 0.2}\n", "planner.zmp_shift_cap"},
+           {"planner: {transition_mu_oracle: fast}\n", "planner.transition_mu_oracle"},
+           {"planner: {portfolio: [{transition_mu_oracle: probing}, {}]}\n", "planner.portfolio[0].transition_mu_oracle"},
            {"planner: {posture_friction_share: 1.2}\n", "planner.posture_friction_share"},
            {"planner: {posture_support_inset_y: -0.02}\n", "planner.posture_support_inset_y"},
            {"planner: {posture_friction_share: 0}\n", "planner.posture_friction_share"}}) {

@@ -95,6 +95,11 @@ void readFields(const YamlField& f, PlannerParameters& p) {
     p.posture.problem.friction_share = v;
   }
   // The interpolator's (withScenarioMargins); checked here with the rest of the section.
+  if (f.has("transition_mu_oracle")) {
+    const std::string v = f["transition_mu_oracle"].string();
+    if (v != "quality-function" && v != "probing" && v != "loqo")
+      f["transition_mu_oracle"].fail("quality-function, probing or loqo");
+  }
   if (f.has("zmp_shift_cap")) {
     const double v = f["zmp_shift_cap"].number();
     if (!(v >= 0 && v < 0.1)) f["zmp_shift_cap"].fail("a length in [0, 0.1) m (0: no such bound)");
@@ -138,7 +143,7 @@ PlannerParameters plannerParameters(const Scenario& sc) {
   const YamlField& f = *sc.planner_section;
   std::vector<std::string> allowed = kVariantKeys;
   for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_seconds", "verify_transitions",
-                          "verify_on_expansion", "zmp_shift_cap", "portfolio"})
+                          "verify_on_expansion", "zmp_shift_cap", "transition_mu_oracle", "portfolio"})
     allowed.push_back(key);
   f.allowOnly(allowed);
   readFields(f, p);
