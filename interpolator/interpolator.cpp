@@ -59,8 +59,8 @@ std::string validateOptions(const InterpolatorOptions& o) {
     return "repair attempts, refinement depth and posture iterations must be non-negative, the repair step positive";
   if (!(o.wide_clearance >= 0 && o.wide_clearance < 0.05)) return "the wide clearance must be in [0, 0.05) m";
   if (o.threads < 1) return "threads must be at least 1";
-  if (o.posture_mu_oracle != "quality-function" && o.posture_mu_oracle != "probing" && o.posture_mu_oracle != "loqo")
-    return "the barrier oracle must be quality-function, probing or loqo, not '" + o.posture_mu_oracle + "'";
+  if (!isMuOracle(o.posture_mu_oracle))
+    return "the barrier oracle must be " + muOracleChoices() + ", not '" + o.posture_mu_oracle + "'";
   return "";
 }
 

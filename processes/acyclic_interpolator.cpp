@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
   auto* mu_flag = app.add_option("--mu-oracle", o.posture_mu_oracle,
                  "Ipopt's barrier oracle for the knots' posture solves: quality-function, probing or loqo (default: "
                  "the scenario's planner key transition_mu_oracle, else quality-function)")
-                     ->check(CLI::IsMember({"quality-function", "probing", "loqo"}));
+                     ->check(CLI::IsMember(acyclic::muOracles()));
   app.add_option("--link-acceleration-cap", o.link_acceleration_cap,
                  "largest acceleration of any link origin, m/s^2 (joints: the robot file's acceleration_limits)")
       ->capture_default_str();

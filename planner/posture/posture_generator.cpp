@@ -1,6 +1,7 @@
 #include "planner/posture/posture_generator.h"
 #include "planner/posture/kkt_ldl.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <set>
@@ -22,6 +23,23 @@ const char* toString(PostureResult::Status s) {
     case PostureResult::Status::Stopped: return "stopped";
   }
   return "?";
+}
+
+const std::vector<std::string>& muOracles() {
+  static const std::vector<std::string> names = {"quality-function", "probing", "loqo"};
+  return names;
+}
+
+bool isMuOracle(const std::string& name) {
+  const auto& all = muOracles();
+  return std::find(all.begin(), all.end(), name) != all.end();
+}
+
+std::string muOracleChoices() {
+  const auto& all = muOracles();
+  std::string s;
+  for (std::size_t i = 0; i < all.size(); ++i) s += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i];
+  return s;
 }
 
 namespace {
@@ -182,8 +200,8 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
                                 opt_.linear_solver + "'");
   }
   o->SetStringValue("mu_strategy", "adaptive");
-  if (opt_.mu_oracle != "quality-function" && opt_.mu_oracle != "probing" && opt_.mu_oracle != "loqo")
-    throw std::invalid_argument("PostureGeneratorOptions::mu_oracle: expected quality-function, probing or loqo, got '" +
+  if (!isMuOracle(opt_.mu_oracle))
+    throw std::invalid_argument("PostureGeneratorOptions::mu_oracle: expected " + muOracleChoices() + ", got '" +
                                 opt_.mu_oracle + "'");
   o->SetStringValue("mu_oracle", opt_.mu_oracle);
   o->SetNumericValue("tol", opt_.tolerance);

@@ -84,6 +84,12 @@ struct PostureResult {
 
 const char* toString(PostureResult::Status s);
 
+// The barrier oracles PostureGeneratorOptions::mu_oracle takes, and how an
+// error message names them ("quality-function, probing or loqo").
+const std::vector<std::string>& muOracles();
+bool isMuOracle(const std::string& name);
+std::string muOracleChoices();
+
 class PostureGenerator {
  public:
   PostureGenerator(std::shared_ptr<const RobotModel> robot, std::shared_ptr<const Scene> scene,

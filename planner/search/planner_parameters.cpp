@@ -64,7 +64,7 @@ void readFields(const YamlField& f, PlannerParameters& p) {
     p.posture.stop_at_restoration = f["posture_stop_at_restoration"].boolean();
   if (f.has("posture_mu_oracle")) {
     const std::string v = f["posture_mu_oracle"].string();
-    if (v != "quality-function" && v != "probing" && v != "loqo") f["posture_mu_oracle"].fail("quality-function, probing or loqo");
+    if (!isMuOracle(v)) f["posture_mu_oracle"].fail(muOracleChoices());
     p.posture.mu_oracle = v;
   }
   if (f.has("posture_distance_engine")) {
@@ -97,8 +97,7 @@ void readFields(const YamlField& f, PlannerParameters& p) {
   // The interpolator's (withScenarioMargins); checked here with the rest of the section.
   if (f.has("transition_mu_oracle")) {
     const std::string v = f["transition_mu_oracle"].string();
-    if (v != "quality-function" && v != "probing" && v != "loqo")
-      f["transition_mu_oracle"].fail("quality-function, probing or loqo");
+    if (!isMuOracle(v)) f["transition_mu_oracle"].fail(muOracleChoices());
   }
   if (f.has("zmp_shift_cap")) {
     const double v = f["zmp_shift_cap"].number();
