@@ -452,52 +452,16 @@ ACYCLIC_VECTOR_CLONES int factor(int n, int nz, const int* irn, const int* jcn, 
   return 0;
 }
 
-ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
-                         double* b, double* work) {
-  // Columns from t on are the dense trailing block (factor): each holds every
-  // row below its diagonal, contiguously in Lx, and is swept without indices.
-  const int t = denseStart(n, [Lp](int c) { return Lp[c + 1] - Lp[c]; });
-  for (int k = 0; k < n; ++k) work[k] = b[perm[k]];
-  for (int j = 0; j < t; ++j) {
-    const double xj = work[j];
-    const int begin = Lp[j], end = Lp[j + 1];
-    if (consecutiveRows(Li, begin, end)) {  // the configuration's nearly full columns: no indices
-      double* __restrict w = work + Li[begin];
-      const double* __restrict l = Lx + begin;
-      for (int q = 0; q < end - begin; ++q) w[q] -= l[q] * xj;
-    } else {
-      for (int p = begin; p < end; ++p) work[Li[p]] -= Lx[p] * xj;
-    }
-  }
-  for (int j = t; j < n; ++j) {
-    const int len = n - 1 - j;
-    const double xj = work[j];
-    double* __restrict w = work + j + 1;
-    const double* __restrict l = Lx + Lp[j];
-    for (int q = 0; q < len; ++q) w[q] -= l[q] * xj;
-  }
-  for (int j = 0; j < n; ++j) work[j] /= D[j];
-  for (int j = n - 1; j >= t; --j) {
-    const int len = n - 1 - j;
-    double dot;
-    eigenOrderDots<1>(Lx + Lp[j], work + j + 1, len, &dot);
-    work[j] -= dot;
-  }
-  for (int j = t - 1; j >= 0; --j) {
-    double xj = work[j];
-    for (int p = Lp[j]; p < Lp[j + 1]; ++p) xj -= Lx[p] * work[Li[p]];
-    work[j] = xj;
-  }
-  for (int k = 0; k < n; ++k) b[perm[k]] = work[k];
-}
-
 namespace {
 
-// `solve` for R right-hand sides b + r * n, r < R, with every one's
-// arithmetic in solve's order (the same results bit for bit) but the R
-// vectors interleaved in work (work[i * R + r], n * R of it): each entry of
-// L is read once for all R, and the backward sweeps' sums, a chain of
-// dependent additions per vector, run R side by side.
+// The solve of R right-hand sides b + r * n, r < R, interleaved in work
+// (work[i * R + r], n * R of it): each entry of L is read once for all R,
+// and the backward sweeps' sums, a chain of dependent additions per vector,
+// run R side by side. Every vector's arithmetic is in the same order
+// whatever R, so solve() (R = 1) and solveMany() give the same results, bit
+// for bit. Columns from t on are the dense trailing block (factor): each
+// holds every row below its diagonal, contiguously in Lx, and is swept
+// without indices.
 template <int R>
 __attribute__((always_inline)) inline void solveInterleaved(int n, const int* perm, const int* Lp, const int* Li,
                                                             const double* Lx, const double* D, double* b,
@@ -508,10 +472,18 @@ __attribute__((always_inline)) inline void solveInterleaved(int n, const int* pe
   double x[R];
   for (int j = 0; j < t; ++j) {
     for (int r = 0; r < R; ++r) x[r] = work[j * R + r];
-    for (int p = Lp[j]; p < Lp[j + 1]; ++p) {
-      double* __restrict w = work + Li[p] * R;
-      const double l = Lx[p];
-      for (int r = 0; r < R; ++r) w[r] -= l * x[r];
+    const int begin = Lp[j], end = Lp[j + 1];
+    if (consecutiveRows(Li, begin, end)) {  // the configuration's nearly full columns: no indices
+      double* __restrict w = work + Li[begin] * R;
+      const double* __restrict l = Lx + begin;
+      for (int q = 0; q < end - begin; ++q)
+        for (int r = 0; r < R; ++r) w[q * R + r] -= l[q] * x[r];
+    } else {
+      for (int p = begin; p < end; ++p) {
+        double* __restrict w = work + Li[p] * R;
+        const double l = Lx[p];
+        for (int r = 0; r < R; ++r) w[r] -= l * x[r];
+      }
     }
   }
   for (int j = t; j < n; ++j) {
@@ -542,6 +514,11 @@ __attribute__((always_inline)) inline void solveInterleaved(int n, const int* pe
 }
 
 }  // namespace
+
+ACYCLIC_VECTOR_CLONES void solve(int n, const int* perm, const int* Lp, const int* Li, const double* Lx, const double* D,
+                         double* b, double* work) {
+  solveInterleaved<1>(n, perm, Lp, Li, Lx, D, b, work);
+}
 
 ACYCLIC_VECTOR_CLONES void solveMany(int n, int nrhs, const int* perm, const int* Lp, const int* Li, const double* Lx,
                                      const double* D, double* b, double* work) {
