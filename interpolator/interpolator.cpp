@@ -73,7 +73,10 @@ InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions 
   if (f.has("posture_support_inset_y")) o.support_inset_y = f["posture_support_inset_y"].number();
   if (f.has("posture_friction_share")) o.friction_share = f["posture_friction_share"].number();
   if (f.has("zmp_shift_cap")) o.zmp_shift_cap = f["zmp_shift_cap"].number();
-  if (f.has("transition_mu_oracle")) o.posture_mu_oracle = f["transition_mu_oracle"].string();
+  if (f.has("transition_mu_oracle")) {
+    o.posture_mu_oracle = f["transition_mu_oracle"].string();
+    if (!isMuOracle(o.posture_mu_oracle)) f["transition_mu_oracle"].fail(muOracleChoices());
+  }
   return o;
 }
 

@@ -1220,6 +1220,15 @@ TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem)
                                     " --in " + plan + " --out " + dir.path() + "/f.json --mu-oracle fast");
   EXPECT_EQ(bad.status, 2) << bad.output;
   EXPECT_NE(bad.output.find("--mu-oracle"), std::string::npos) << bad.output;
+  // A bad oracle in the scenario is named by its file and field.
+  const std::string bad_scenario =
+      dir.write("bad_oracle.yaml", test::scenarioText("models/scenarios/step_forward.yaml") +
+                                       "planner: {transition_mu_oracle: fast}\n");
+  const auto named = test::runProcess(test::binaryPath("processes/acyclic-interpolator") + " --scenario " +
+                                      bad_scenario + " --in " + plan + " --out " + dir.path() + "/g.json");
+  EXPECT_EQ(named.status, 2) << named.output;
+  EXPECT_NE(named.output.find("bad_oracle.yaml"), std::string::npos) << named.output;
+  EXPECT_NE(named.output.find("planner.transition_mu_oracle"), std::string::npos) << named.output;
 }
 
 TEST(InterpolatorProcess, HelpAndBadInput) {
