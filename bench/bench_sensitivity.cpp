@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
   int max_nodes = -1;
   int threads = 2;
   std::string member;  // of the scenario's portfolio, alone
+  std::vector<std::string> settings;  // --set KEY=VALUE of its planner section
   std::vector<std::string> only;
   auto shift = [](int axis, double by) {
     return [axis, by](Scenario& sc) { sc.start.base_position[axis] += by; };
@@ -88,6 +89,10 @@ int main(int argc, char** argv) {
   app.add_option("--only", only, "run only these perturbations, by name (repeatable; default: all)")
       ->check(CLI::IsMember(names));
   app.add_option("--threads", threads, "posture generators at once (the plan does not depend on it)")->capture_default_str();
+  app.add_option("--set", settings,
+                 "a key of the scenario's planner section, as if its file said so (repeatable; VALUE read as "
+                 "YAML, null for the key's default), applied before --member, as acyclic-planner --set")
+      ->type_name("KEY=VALUE");
   app.add_option("--member", member,
                  "of the scenario's portfolio (planner: portfolio), plan with this member alone, by name "
                  "(default: the whole portfolio)");
@@ -117,6 +122,7 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("--watch " + watch + ": SPOT@SURFACE, a spot of " + path +
                                     "'s robot and a surface of its scene");
     }
+    setPlannerKeys(loaded, settings);
     shipped = plannerParameters(loaded);
     if (!member.empty()) keepPortfolioMember(shipped, member, path);
   } catch (const std::exception& e) {

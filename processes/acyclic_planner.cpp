@@ -52,6 +52,13 @@ int main(int argc, char** argv) {
   app.add_option("--member", o.member,
                  "of the scenario's portfolio (planner: portfolio), plan with this member alone, on every thread "
                  "(default: the whole portfolio; its plan is the winning member's)");
+  app.add_option("--set", o.set,
+                 "a key of the scenario's planner section, as if its file said so (repeatable; VALUE read as YAML, "
+                 "null for the key's default; e.g. --set posture_mu_oracle=probing --set portfolio=null). The "
+                 "verification of transitions reads them too; give acyclic-interpolator the same margins "
+                 "(--support-inset, --friction-share, --zmp-shift-cap, --mu-oracle) to interpolate the plan as it "
+                 "was verified")
+      ->type_name("KEY=VALUE");
   app.add_flag("--eager-sons", o.eager_sons, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
   app.add_flag("--random-candidates", o.random_candidates,
                "ablation: random (x, y, theta) samples instead of optimized candidates (paper 2.6)");
@@ -89,6 +96,12 @@ int main(int argc, char** argv) {
   if (on_expansion) o.verify_on_expansion = 1;
   if (no_on_expansion) o.verify_on_expansion = 0;
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
+  try {  // said now, not at the first request
+    acyclic::checkPlannerSettings(o.set);
+  } catch (const acyclic::FormatError& e) {
+    std::fprintf(stderr, "acyclic-planner: %s\n", e.what());
+    return 2;
+  }
 
   acyclic::proc::installSignalHandlers();
   if (lcm_mode) {

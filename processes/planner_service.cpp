@@ -30,6 +30,7 @@ constexpr bool kVerifyTransitionsByDefault = false;  // nothing to verify with
 }  // namespace
 
 PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s) const {
+  setPlannerKeys(sc, set);
   if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
   PlannerParameters p = plannerParameters(sc);
   if (!member.empty()) keepPortfolioMember(p, member, sc.name);

@@ -2,6 +2,7 @@
 // The contact planner on LCM: ACYCLIC_REQUEST in, ACYCLIC_PLAN out, with
 // progress, status and cancellation (docs/design.md section 2).
 #include <string>
+#include <vector>
 
 #include "planner/search/contact_planner.h"
 
@@ -18,6 +19,9 @@ struct PlannerOverrides {
   int verify_on_expansion = -1;  // -1: the scenario's (planner: verify_on_expansion), 0 off, 1 on
   bool verbose = false;  // one line per expanded node on stderr
   std::string member;    // of the scenario's portfolio, planned alone (empty: the whole portfolio)
+  // KEY=VALUE settings of the scenario's planner section (setPlannerKeys),
+  // applied before everything above.
+  std::vector<std::string> set;
   // The scenario's parameters with these overrides; a request's time budget
   // (> 0) applies unless --max-seconds is given. Also sets sc.seed. With
   // verify_transitions, the interpolator's verifier (built only with it).

@@ -71,6 +71,27 @@ TEST(AcyclicPlanner, ContradictoryFlagsAndABadKeyAreBadInput) {
   EXPECT_NE(bad2.output.find("verify_on_expansion"), std::string::npos) << bad2.output;
 }
 
+// --set KEY=VALUE: a planner key from the command line, over the scenario's;
+// a bad one is bad input, said before any search (also in LCM mode, before
+// serving).
+TEST(AcyclicPlanner, SetGivesAPlannerKeyFromTheCommandLine) {
+  acyclic::test::TempDir dir;
+  const std::string s = sourcePath("models/scenarios/step_forward.yaml");
+  const auto cut = plan(s, dir.path() + "/cut.json", "--no-verify-transitions --set max_nodes=3");
+  EXPECT_EQ(cut.status, 1) << cut.output;
+  EXPECT_NE(cut.output.find("3 nodes generated without reaching the goal"), std::string::npos) << cut.output;
+  const auto bad = plan(s, dir.path() + "/bad.json", "--set posture_distance_engine=bullet");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--set: field 'planner.posture_distance_engine': expected fcl or convex"),
+            std::string::npos)
+      << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/bad.json"));
+  const auto served = runProcess("timeout 30 " + binaryPath("processes/acyclic-planner") +
+                                 " --lcm --lcm-url memq:// --set no_such_key=1");
+  EXPECT_EQ(served.status, 2) << served.output;
+  EXPECT_NE(served.output.find("--set: field 'planner.no_such_key'"), std::string::npos) << served.output;
+}
+
 // --keep-refused DIR: made before the search (a path that cannot be a
 // directory is bad input, said at once), nothing in it when no plan is
 // refused; not with --lcm. What it writes: ContactPlanner.APlanWhoseTransition...

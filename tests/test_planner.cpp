@@ -411,6 +411,57 @@ TEST(PlannerParameters, ReadFromTheScenarioWithNamedErrors) {
   }
 }
 
+// --set KEY=VALUE (acyclic-planner, bench_sensitivity): a planner key given
+// on the command line acts as the scenario's own, over it; null drops the
+// scenario's; a bad one is named as coming from --set, and nothing is set.
+TEST(PlannerParameters, CommandLineSettingsActAsTheScenariosKeysAndAreNamedWhenBad) {
+  test::TempDir dir;
+  const std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+  const std::string path = dir.write(
+      "a.yaml", text + "planner: {max_nodes: 77, portfolio: [{name: a}, {name: b, posture_mu_oracle: probing}]}\n");
+  Scenario sc = Scenario::load(path);
+  setPlannerKeys(sc, {"duplicate_distance=0.07"});
+  PlannerParameters p = plannerParameters(sc);
+  EXPECT_DOUBLE_EQ(p.duplicate_distance, 0.07);
+  EXPECT_EQ(p.max_nodes, 77);  // the scenario's other keys kept
+  EXPECT_EQ(p.portfolio.size(), 2u);
+  setPlannerKeys(sc, {"max_nodes=88", "posture_distance_engine=convex", "box_half_sizes=[0.1, 0.2, 0.3]",
+                      "portfolio=null", "posture_lbfgs_in_kkt=true"});
+  p = plannerParameters(sc);
+  EXPECT_EQ(p.max_nodes, 88);
+  EXPECT_EQ(p.posture.distance_engine, DistanceEngine::Convex);
+  EXPECT_DOUBLE_EQ(p.box.y, 0.2);
+  EXPECT_TRUE(p.portfolio.empty());
+  EXPECT_TRUE(p.posture.lbfgs_in_kkt);
+  EXPECT_DOUBLE_EQ(p.duplicate_distance, 0.07);  // from the first call
+  // A scenario without a planner section gets one.
+  Scenario plain = Scenario::load(dir.write("b.yaml", text));
+  ASSERT_FALSE(plain.planner_section);
+  setPlannerKeys(plain, {"max_seconds=5"});
+  EXPECT_DOUBLE_EQ(plannerParameters(plain).max_seconds, 5);
+  // Bad settings: named as --set's, and none of the list is applied.
+  for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
+           {"max_nodes=0", "planner.max_nodes"},
+           {"max_node=5", "planner.max_node"},
+           {"posture_mu_oracle=fast", "planner.posture_mu_oracle"},
+           {"portfolio=[{name: a}]", "planner.portfolio"},
+           {"max_nodes=[1", "planner.max_nodes"},
+           {"max_nodes", ""},
+           {"max_nodes=", "planner.max_nodes"},
+           {"=3", ""}}) {
+    try {
+      setPlannerKeys(sc, {"max_nodes=99", bad});
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const FormatError& e) {
+      EXPECT_EQ(e.file(), "--set") << e.what();
+      EXPECT_EQ(e.field(), field) << e.what();
+    }
+    EXPECT_EQ(plannerParameters(sc).max_nodes, 88) << bad;
+    EXPECT_THROW(checkPlannerSettings({bad}), FormatError) << bad;
+  }
+  EXPECT_NO_THROW(checkPlannerSettings({"portfolio=null", "max_nodes=5"}));
+}
+
 // Lazy verification (PlannerParameters::verify_transitions): a plan whose
 // transition the verifier refuses is not returned; the stance that
 // transition leads to is dropped with its subtree and the search goes on to

@@ -1,6 +1,9 @@
 #include "planner/search/planner_parameters.h"
 
 #include <stdexcept>
+#include <utility>
+
+#include <yaml-cpp/yaml.h>
 
 #include "planner/scene/friction.h"
 
@@ -134,17 +137,39 @@ std::vector<PlannerVariant> portfolioOf(const YamlField& list, const PlannerPara
   return members;
 }
 
+// Every key of a planner section.
+std::vector<std::string> plannerKeys() {
+  std::vector<std::string> allowed = kVariantKeys;
+  for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_seconds", "verify_transitions",
+                          "verify_on_expansion", "zmp_shift_cap", "transition_mu_oracle", "portfolio"})
+    allowed.push_back(key);
+  return allowed;
+}
+
+// "KEY=VALUE" as the key and VALUE read as YAML (FormatError naming --set).
+std::pair<std::string, YAML::Node> parseSetting(const std::string& setting) {
+  const auto eq = setting.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw FormatError("--set", "", "expected KEY=VALUE (a key of the scenario's planner section, docs/design.md "
+                                   "section 5), got '" + setting + "'");
+  const std::string key = setting.substr(0, eq);
+  if (eq + 1 == setting.size())
+    throw FormatError("--set", "planner." + key, "expected a value after '=' (null to drop the scenario's own)");
+  try {
+    return {key, YAML::Load(setting.substr(eq + 1))};
+  } catch (const YAML::Exception& e) {
+    throw FormatError("--set", "planner." + key, "expected a YAML value, got '" + setting.substr(eq + 1) +
+                                                     "' (" + e.msg + ")");
+  }
+}
+
 }  // namespace
 
 PlannerParameters plannerParameters(const Scenario& sc) {
   PlannerParameters p;
   if (!sc.planner_section) return p;
   const YamlField& f = *sc.planner_section;
-  std::vector<std::string> allowed = kVariantKeys;
-  for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_seconds", "verify_transitions",
-                          "verify_on_expansion", "zmp_shift_cap", "transition_mu_oracle", "portfolio"})
-    allowed.push_back(key);
-  f.allowOnly(allowed);
+  f.allowOnly(plannerKeys());
   readFields(f, p);
   if (f.has("portfolio")) p.portfolio = portfolioOf(f["portfolio"], p);
   return p;
@@ -165,6 +190,30 @@ void keepPortfolioMember(PlannerParameters& p, const std::string& name, const st
   throw std::invalid_argument(scenario + ": --member: no portfolio member named \"" + name + "\" (" +
                               (names.empty() ? std::string("the scenario has no portfolio") : "its members: " + names) +
                               ")");
+}
+
+void checkPlannerSettings(const std::vector<std::string>& settings) {
+  for (const std::string& setting : settings) {
+    const auto [key, value] = parseSetting(setting);
+    YAML::Node alone(YAML::NodeType::Map);
+    alone[key] = value.IsNull() ? YAML::Node() : value;
+    Scenario check;
+    check.planner_section = YamlField(alone, "--set", "planner");
+    check.planner_section->allowOnly(plannerKeys());
+    if (!value.IsNull()) plannerParameters(check);  // a bad value fails here, named
+  }
+}
+
+void setPlannerKeys(Scenario& sc, const std::vector<std::string>& settings) {
+  if (settings.empty()) return;
+  checkPlannerSettings(settings);
+  YAML::Node section = sc.planner_section ? YAML::Clone(sc.planner_section->node()) : YAML::Node(YAML::NodeType::Map);
+  for (const std::string& setting : settings) {
+    const auto [key, value] = parseSetting(setting);
+    if (value.IsNull()) section.remove(key);
+    else section[key] = value;
+  }
+  sc.planner_section = YamlField(section, sc.planner_section ? sc.planner_section->file() : sc.path, "planner");
 }
 
 }  // namespace acyclic
