@@ -16,6 +16,7 @@
 #include "planner/common/format_error.h"
 #include "planner/plan/scenario_reference.h"
 #include "processes/lcm_process.h"
+#include "planner/search/planner_parameters.h"
 #include "processes/interpolator_service.h"
 
 namespace {
@@ -79,6 +80,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--lift", o.lift, "straight motion along the surface normal on leaving and reaching, m")
       ->capture_default_str();
+  std::vector<std::string> settings;
+  app.add_option("--set", settings,
+                 "a key of the scenario's planner section, as if its file said so (repeatable; as acyclic-planner "
+                 "--set, whose settings to give here too to interpolate a plan as it was verified): the margins "
+                 "and oracle above read posture_support_inset, posture_support_inset_y, posture_friction_share, "
+                 "zmp_shift_cap and transition_mu_oracle from it; their own options still come first")
+      ->type_name("KEY=VALUE");
   app.add_flag("--no-filter", no_filter, "keep every stance of the plan");
   app.add_option("--threads", o.threads, "transitions solved at once (the result does not depend on it)")
       ->check(CLI::PositiveNumber)
@@ -94,8 +102,16 @@ int main(int argc, char** argv) {
   const bool inset_given = inset_flag->count() > 0, inset_y_given = inset_y_flag->count() > 0,
              share_given = share_flag->count() > 0, zmp_given = zmp_flag->count() > 0,
              mu_given = mu_flag->count() > 0;
+  try {  // said now, not at the first plan
+    acyclic::checkPlannerSettings(settings);
+  } catch (const acyclic::FormatError& e) {
+    std::fprintf(stderr, "acyclic-interpolator: %s\n", e.what());
+    return 2;
+  }
   const acyclic::InterpolatorOptionsFor options_for = [=](const acyclic::Scenario& sc) {
-    acyclic::InterpolatorOptions r = acyclic::withScenarioMargins(sc, o);
+    acyclic::Scenario set = sc;
+    acyclic::setPlannerKeys(set, settings);
+    acyclic::InterpolatorOptions r = acyclic::withScenarioMargins(set, o);
     if (inset_given) r.support_inset = o.support_inset;
     if (inset_y_given) r.support_inset_y = o.support_inset_y;
     if (share_given) r.friction_share = o.friction_share;

@@ -55,9 +55,8 @@ int main(int argc, char** argv) {
   app.add_option("--set", o.set,
                  "a key of the scenario's planner section, as if its file said so (repeatable; VALUE read as YAML, "
                  "null for the key's default; e.g. --set posture_mu_oracle=probing --set portfolio=null). The "
-                 "verification of transitions reads them too; give acyclic-interpolator the same margins "
-                 "(--support-inset, --friction-share, --zmp-shift-cap, --mu-oracle) to interpolate the plan as it "
-                 "was verified")
+                 "verification of transitions reads them too; give acyclic-interpolator the same --set to "
+                 "interpolate the plan as it was verified")
       ->type_name("KEY=VALUE");
   app.add_flag("--eager-sons", o.eager_sons, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
   app.add_flag("--random-candidates", o.random_candidates,

@@ -5,6 +5,8 @@
 // sample by the independent trajectory check.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <algorithm>
 
 #include <atomic>
@@ -1229,6 +1231,21 @@ TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem)
   EXPECT_EQ(named.status, 2) << named.output;
   EXPECT_NE(named.output.find("bad_oracle.yaml"), std::string::npos) << named.output;
   EXPECT_NE(named.output.find("planner.transition_mu_oracle"), std::string::npos) << named.output;
+  // --set, as acyclic-planner's: the scenario's keys given on the command
+  // line (here the margins and oracle taken off again), its own options first.
+  const Trajectory set_none = run("h.json", "--set posture_support_inset=0 --set posture_friction_share=null");
+  ASSERT_EQ(set_none.samples.size(), none.samples.size());
+  for (std::size_t k = 0; k < none.samples.size(); ++k)
+    ASSERT_EQ(set_none.samples[k].q.joints, none.samples[k].q.joints) << "sample " << k;
+  const Trajectory set_overridden = run("i.json", "--set posture_support_inset=0 --support-inset 0.06");
+  ASSERT_EQ(set_overridden.samples.size(), by_scenario.samples.size());
+  for (std::size_t k = 0; k < by_scenario.samples.size(); ++k)
+    ASSERT_EQ(set_overridden.samples[k].q.joints, by_scenario.samples[k].q.joints) << "sample " << k;
+  const auto bad_set = test::runProcess(test::binaryPath("processes/acyclic-interpolator") + " --scenario " + scenario +
+                                        " --in " + plan + " --out " + dir.path() + "/j.json --set transition_mu_oracle=fast");
+  EXPECT_EQ(bad_set.status, 2) << bad_set.output;
+  EXPECT_NE(bad_set.output.find("--set: field 'planner.transition_mu_oracle'"), std::string::npos) << bad_set.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/j.json"));
 }
 
 TEST(InterpolatorProcess, HelpAndBadInput) {
