@@ -37,9 +37,10 @@ struct PlannerOverrides {
   long max_posture_calls = -1;
   bool verify = false;  // verify transitions (the planner's default in acyclic-planner)
   std::string member;   // of the scenario's portfolio, alone (empty: the whole portfolio)
+  std::vector<std::string> set;  // KEY=VALUE settings of the planner section (setPlannerKeys)
 
   // --max-seconds, --max-nodes, --max-posture-calls (each per `per`),
-  // --member, and --verify-transitions where the interpolator is built.
+  // --set, --member, and --verify-transitions where the interpolator is built.
   void addOptions(CLI::App& app, const std::string& per) {
     app.add_option("--max-seconds", max_seconds, "time budget per " + per + ", s (default: the scenario's)")
         ->check(positive());
@@ -48,6 +49,10 @@ struct PlannerOverrides {
     app.add_option("--max-posture-calls", max_posture_calls,
                    "posture-generator calls at most per " + per + " (default: the scenario's)")
         ->check(positive());
+    app.add_option("--set", set,
+                   "a key of each scenario's planner section, as if its file said so (repeatable; VALUE read as "
+                   "YAML, null for the key's default), before --member, as acyclic-planner --set")
+        ->type_name("KEY=VALUE");
     app.add_option("--member", member,
                    "of the scenario's portfolio (planner: portfolio), plan with this member alone, by name, as "
                    "acyclic-planner --member (default: the whole portfolio)");
@@ -70,9 +75,16 @@ struct PlannerOverrides {
     }
   }
 
+  // The scenario with --set's keys in its planner section.
+  Scenario withSet(const Scenario& sc) const {
+    Scenario s = sc;
+    setPlannerKeys(s, set);
+    return s;
+  }
+
   // The scenario's parameters with these changes, without a verifier.
   PlannerParameters settings(const Scenario& sc) const {
-    PlannerParameters p = plannerParameters(sc);
+    PlannerParameters p = plannerParameters(withSet(sc));
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (max_nodes > 0) p.max_nodes = max_nodes;
     if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
@@ -85,7 +97,7 @@ struct PlannerOverrides {
   PlannerParameters parameters(const Scenario& sc) const {
     PlannerParameters p = settings(sc);
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
-    attachPlanVerifier(p, sc);
+    attachPlanVerifier(p, withSet(sc));  // its margins and oracle as --set gives them
 #endif
     return p;
   }
