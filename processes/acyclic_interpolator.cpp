@@ -15,8 +15,8 @@
 #include "planner/posture/heap_tuning.h"
 #include "planner/common/format_error.h"
 #include "planner/plan/scenario_reference.h"
-#include "processes/lcm_process.h"
 #include "planner/search/planner_parameters.h"
+#include "processes/lcm_process.h"
 #include "processes/interpolator_service.h"
 
 namespace {
