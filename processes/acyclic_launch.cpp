@@ -144,6 +144,11 @@ int main(int argc, char** argv) {
   app.add_option("--bridge-config", bridge_config, "acyclic-hrp2-bridge's configuration (acyclic.hrp2_bridge/1)")
       ->capture_default_str();
   app.add_option("--planner-arg", planner_args, "extra argument for acyclic-planner (repeatable)");
+  std::vector<std::string> settings;
+  app.add_option("--set", settings,
+                 "a key of the scenario's planner section, given to acyclic-planner and acyclic-interpolator alike "
+                 "(their --set; repeatable), so that the plan is interpolated as it was verified")
+      ->type_name("KEY=VALUE");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
 
@@ -193,6 +198,8 @@ int main(int argc, char** argv) {
       ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--lcm"}, (fs::path(out_dir) / (name + ".log")).string()};
       if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
       if (name == "acyclic-planner") c.argv.insert(c.argv.end(), planner_args.begin(), planner_args.end());
+      if (name == "acyclic-planner" || name == "acyclic-interpolator")
+        for (const auto& kv : settings) c.argv.insert(c.argv.end(), {"--set", kv});
       sup.start(c);
     }
 

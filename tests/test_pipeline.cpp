@@ -302,6 +302,18 @@ TEST(Pipeline, APlannerKilledMidRequestIsRestartedAndTheLauncherResendsItsWork) 
   EXPECT_EQ(run.status, 1) << run.output;
 }
 
+// --set goes to the planner (and the interpolator): a node budget of 3 is
+// one step_forward cannot be planned in, and the planner says so.
+TEST(Pipeline, SetGoesToThePlannersPlannerSection) {
+  REQUIRE_NETNS();
+  test::TempDir dir;
+  const auto run = test::runProcess(exe("acyclic-launch") + " -q --no-interpolate --timeout 60 --set max_nodes=3 " +
+                                    "--scenario " + test::sourcePath("models/scenarios/step_forward.yaml") +
+                                    " --out " + dir.path());
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("3 nodes generated without reaching the goal"), std::string::npos) << run.output;
+}
+
 namespace {
 
 // Starts a process (no shell); returns its pid.
