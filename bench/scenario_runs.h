@@ -83,22 +83,27 @@ struct PlannerOverrides {
   }
 
   // The scenario's parameters with these changes, without a verifier.
-  PlannerParameters settings(const Scenario& sc) const {
-    PlannerParameters p = plannerParameters(withSet(sc));
+  PlannerParameters settings(const Scenario& sc) const { return settingsOf(withSet(sc)); }
+
+  // settings(), and a verifier when they verify transitions.
+  PlannerParameters parameters(const Scenario& sc) const {
+    const Scenario set = withSet(sc);
+    PlannerParameters p = settingsOf(set);
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+    attachPlanVerifier(p, set);  // its margins and oracle as --set gives them
+#endif
+    return p;
+  }
+
+ private:
+  // settings() of a scenario that already has --set's keys.
+  PlannerParameters settingsOf(const Scenario& sc) const {
+    PlannerParameters p = plannerParameters(sc);
     if (max_seconds > 0) p.max_seconds = max_seconds;
     if (max_nodes > 0) p.max_nodes = max_nodes;
     if (max_posture_calls > 0) p.max_posture_calls = max_posture_calls;
     if (verify) p.verify_transitions = true;
     if (!member.empty()) keepPortfolioMember(p, member, sc.path);
-    return p;
-  }
-
-  // settings(), and a verifier when they verify transitions.
-  PlannerParameters parameters(const Scenario& sc) const {
-    PlannerParameters p = settings(sc);
-#ifdef ACYCLIC_HAVE_INTERPOLATOR
-    attachPlanVerifier(p, withSet(sc));  // its margins and oracle as --set gives them
-#endif
     return p;
   }
 };

@@ -163,16 +163,35 @@ std::pair<std::string, YAML::Node> parseSetting(const std::string& setting) {
   }
 }
 
-}  // namespace
-
-PlannerParameters plannerParameters(const Scenario& sc) {
+// The parameters a planner section gives (FormatError naming its file and field).
+PlannerParameters parametersOf(const YamlField& f) {
   PlannerParameters p;
-  if (!sc.planner_section) return p;
-  const YamlField& f = *sc.planner_section;
   f.allowOnly(plannerKeys());
   readFields(f, p);
   if (f.has("portfolio")) p.portfolio = portfolioOf(f["portfolio"], p);
   return p;
+}
+
+// The settings as (key, value), each read on its own as the scenario's keys
+// are (a bad one is a FormatError naming --set and its field).
+std::vector<std::pair<std::string, YAML::Node>> checkedSettings(const std::vector<std::string>& settings) {
+  std::vector<std::pair<std::string, YAML::Node>> out;
+  for (const std::string& setting : settings) {
+    auto [key, value] = parseSetting(setting);
+    YAML::Node alone(YAML::NodeType::Map);
+    alone[key] = value;
+    const YamlField f(alone, "--set", "planner");
+    if (value.IsNull()) f.allowOnly(plannerKeys());  // a key to drop: only its name to check
+    else parametersOf(f);
+    out.emplace_back(std::move(key), std::move(value));
+  }
+  return out;
+}
+
+}  // namespace
+
+PlannerParameters plannerParameters(const Scenario& sc) {
+  return sc.planner_section ? parametersOf(*sc.planner_section) : PlannerParameters();
 }
 
 void keepPortfolioMember(PlannerParameters& p, const std::string& name, const std::string& scenario) {
@@ -192,24 +211,13 @@ void keepPortfolioMember(PlannerParameters& p, const std::string& name, const st
                               ")");
 }
 
-void checkPlannerSettings(const std::vector<std::string>& settings) {
-  for (const std::string& setting : settings) {
-    const auto [key, value] = parseSetting(setting);
-    YAML::Node alone(YAML::NodeType::Map);
-    alone[key] = value.IsNull() ? YAML::Node() : value;
-    Scenario check;
-    check.planner_section = YamlField(alone, "--set", "planner");
-    check.planner_section->allowOnly(plannerKeys());
-    if (!value.IsNull()) plannerParameters(check);  // a bad value fails here, named
-  }
-}
+void checkPlannerSettings(const std::vector<std::string>& settings) { checkedSettings(settings); }
 
 void setPlannerKeys(Scenario& sc, const std::vector<std::string>& settings) {
   if (settings.empty()) return;
-  checkPlannerSettings(settings);
+  const auto checked = checkedSettings(settings);  // all of them before any is set
   YAML::Node section = sc.planner_section ? YAML::Clone(sc.planner_section->node()) : YAML::Node(YAML::NodeType::Map);
-  for (const std::string& setting : settings) {
-    const auto [key, value] = parseSetting(setting);
+  for (const auto& [key, value] : checked) {
     if (value.IsNull()) section.remove(key);
     else section[key] = value;
   }
