@@ -83,9 +83,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> settings;
   app.add_option("--set", settings,
                  "a key of the scenario's planner section, as if its file said so (repeatable; as acyclic-planner "
-                 "--set, whose settings to give here too to interpolate a plan as it was verified): the margins "
-                 "and oracle above read posture_support_inset, posture_support_inset_y, posture_friction_share, "
-                 "zmp_shift_cap and transition_mu_oracle from it; their own options still come first")
+                 "--set): the margins and oracle above read posture_support_inset, posture_support_inset_y, "
+                 "posture_friction_share, zmp_shift_cap and transition_mu_oracle from it; their own options still "
+                 "come first. File mode: a plan's own planner_settings (the planner's --set) apply first, these "
+                 "after them; --lcm: give the planner's here too (acyclic-launch --set does)")
       ->type_name("KEY=VALUE");
   app.add_flag("--no-filter", no_filter, "keep every stance of the plan");
   app.add_option("--threads", o.threads, "transitions solved at once (the result does not depend on it)")
@@ -108,8 +109,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "acyclic-interpolator: %s\n", e.what());
     return 2;
   }
-  const acyclic::InterpolatorOptionsFor options_for = [=](const acyclic::Scenario& sc) {
+  // plan_settings: those the plan file recorded (the planner's --set), which
+  // the command line's follow.
+  const auto options_with = [=](const acyclic::Scenario& sc, const std::vector<std::string>& plan_settings,
+                                const std::string& plan_path) {
     acyclic::Scenario set = sc;
+    acyclic::setPlannerKeys(set, plan_settings, plan_path + " (planner_settings)");
     acyclic::setPlannerKeys(set, settings);
     acyclic::InterpolatorOptions r = acyclic::withScenarioMargins(set, o);
     if (inset_given) r.support_inset = o.support_inset;
@@ -118,6 +123,9 @@ int main(int argc, char** argv) {
     if (zmp_given) r.zmp_shift_cap = o.zmp_shift_cap;
     if (mu_given) r.posture_mu_oracle = o.posture_mu_oracle;
     return r;
+  };
+  const acyclic::InterpolatorOptionsFor options_for = [=](const acyclic::Scenario& sc) {
+    return options_with(sc, {}, "");
   };
   acyclic::keepSolverWorkspaceInHeap();  // planner/posture/heap_tuning.h
   if (lcm_mode) {
@@ -145,7 +153,13 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "\r%7.1f s  %-11s transition %d of %d  posture calls %ld   ", p.seconds, p.stage.c_str(),
                    p.transition, p.transitions, p.posture_calls);
     };
-    acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, options_for(sc), progress, &g_stop);
+    const acyclic::InterpolatorOptions options = options_with(sc, plan.planner_settings, in);
+    if (!plan.planner_settings.empty() && !quiet) {
+      std::string keys;
+      for (const std::string& k : plan.planner_settings) keys += (keys.empty() ? "" : ", ") + k;
+      std::fprintf(stderr, "acyclic-interpolator: %s was planned with --set %s: applied\n", in.c_str(), keys.c_str());
+    }
+    acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, options, progress, &g_stop);
     if (tty) std::fprintf(stderr, "\n");
     if (verbose)
       for (const acyclic::TransitionRecord& t : r.transitions)

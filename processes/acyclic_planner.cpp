@@ -55,8 +55,8 @@ int main(int argc, char** argv) {
   app.add_option("--set", o.set,
                  "a key of the scenario's planner section, as if its file said so (repeatable; VALUE read as YAML, "
                  "null for the key's default; e.g. --set posture_mu_oracle=probing --set portfolio=null). The "
-                 "verification of transitions reads them too; give acyclic-interpolator the same --set to "
-                 "interpolate the plan as it was verified")
+                 "verification of transitions reads them too, and the plan file records them (planner_settings), "
+                 "which acyclic-interpolator applies: the plan is interpolated as it was verified")
       ->type_name("KEY=VALUE");
   app.add_flag("--eager-sons", o.eager_sons, "ablation: every son of a node at once instead of lazy sons (paper 2.8)");
   app.add_flag("--random-candidates", o.random_candidates,
@@ -145,7 +145,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "\n%7.1f s  a plan found: verifying its transitions (%ld plans refused so far)\n",
                      s.seconds, s.plans_refused);
     };
-    const acyclic::PlanningResult r = planner.plan(&acyclic::proc::stopFlag(), progress);
+    acyclic::PlanningResult r = planner.plan(&acyclic::proc::stopFlag(), progress);
+    // The plan files say which keys the command line set, so that the
+    // interpolator applies them without being told again.
+    r.plan.planner_settings = o.set;
+    for (acyclic::RefusedPlan& rp : r.refused_plans) rp.plan.planner_settings = o.set;
     if (tty) std::fprintf(stderr, "\n");
     const auto& s = r.stats;
     std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated, %ld expanded, %ld posture calls (%ld failed), "

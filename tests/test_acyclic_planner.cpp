@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "test_support.h"
 
@@ -86,6 +89,16 @@ TEST(AcyclicPlanner, SetGivesAPlannerKeyFromTheCommandLine) {
             std::string::npos)
       << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/bad.json"));
+  // The plan file records the settings, in order, for the interpolator
+  // (InterpolatorProcess.TakesTheScenariosMarginsUnlessTheCommandLineGivesThem).
+  const auto recorded = plan(s, dir.path() + "/set.json", "--no-verify-transitions --set max_nodes=500 --set threads=1");
+  ASSERT_EQ(recorded.status, 0) << recorded.output;
+  auto json = [](const std::string& path) { return nlohmann::json::parse(std::ifstream(path)); };
+  EXPECT_EQ(json(dir.path() + "/set.json").at("planner_settings"),
+            nlohmann::json::array({"max_nodes=500", "threads=1"}));
+  const auto plain = plan(s, dir.path() + "/plain.json", "--no-verify-transitions");
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  EXPECT_FALSE(json(dir.path() + "/plain.json").contains("planner_settings"));
   const auto served = runProcess("timeout 30 " + binaryPath("processes/acyclic-planner") +
                                  " --lcm --lcm-url memq:// --set no_such_key=1");
   EXPECT_EQ(served.status, 2) << served.output;

@@ -1246,6 +1246,30 @@ TEST(InterpolatorProcess, TakesTheScenariosMarginsUnlessTheCommandLineGivesThem)
   EXPECT_EQ(bad_set.status, 2) << bad_set.output;
   EXPECT_NE(bad_set.output.find("--set: field 'planner.transition_mu_oracle'"), std::string::npos) << bad_set.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/j.json"));
+  // A plan planned with --set records the settings (planner_settings): they
+  // apply without being given again, and the command line's after them.
+  Plan recorded = stepPlan(sc, 0.15);
+  recorded.planner_settings = {"posture_support_inset=0", "posture_friction_share=null"};
+  writePlan(recorded, sc, plan);
+  const Trajectory by_plan = run("k.json", "");
+  ASSERT_EQ(by_plan.samples.size(), none.samples.size());
+  for (std::size_t k = 0; k < none.samples.size(); ++k)
+    ASSERT_EQ(by_plan.samples[k].q.joints, none.samples[k].q.joints) << "sample " << k;
+  const Trajectory plan_then_set =
+      run("l.json", "--set posture_support_inset=0.06 --set posture_friction_share=0.5");
+  ASSERT_EQ(plan_then_set.samples.size(), by_scenario.samples.size());
+  for (std::size_t k = 0; k < by_scenario.samples.size(); ++k)
+    ASSERT_EQ(plan_then_set.samples[k].q.joints, by_scenario.samples[k].q.joints) << "sample " << k;
+  // A bad recorded setting is named by the plan file and the field.
+  recorded.planner_settings = {"posture_friction_share=2"};
+  writePlan(recorded, sc, plan);
+  const auto bad_recorded = test::runProcess(test::binaryPath("processes/acyclic-interpolator") + " --scenario " +
+                                             scenario + " --in " + plan + " --out " + dir.path() + "/m.json");
+  EXPECT_EQ(bad_recorded.status, 2) << bad_recorded.output;
+  EXPECT_NE(bad_recorded.output.find(plan + " (planner_settings): field 'planner.posture_friction_share'"),
+            std::string::npos)
+      << bad_recorded.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/m.json"));
 }
 
 TEST(InterpolatorProcess, HelpAndBadInput) {

@@ -106,6 +106,13 @@ TEST(PlanFile, RoundTripIsExact) {
   // Forces are written for supporting contacts only.
   EXPECT_TRUE(back.stances[1].contacts.back().forces.empty());
   EXPECT_EQ(back.stances[2].contacts.back().forces.size(), 4u);
+  // No planner settings: no field (the files of plans planned without --set
+  // are as before); with them, read back in order.
+  EXPECT_TRUE(back.planner_settings.empty());
+  EXPECT_EQ(planToJson(plan, sc).find("planner_settings"), std::string::npos);
+  Plan set = plan;
+  set.planner_settings = {"posture_mu_oracle=probing", "portfolio=null"};
+  EXPECT_EQ(planFromJson(planToJson(set, sc), "set.json", sc).planner_settings, set.planner_settings);
 }
 
 TEST(PlanCheck, ValidStancesAndTheSequenceRules) {
@@ -148,6 +155,10 @@ TEST(PlanFile, BadFieldsAreNamed) {
   expectField("\"spot\": \"r_sole\"", "\"spot\": \"r_foot\"", "stances[0].contacts[0].spot");
   expectField("\"supporting\": true", "\"supporting\": 1", "stances[0].contacts[0].supporting");
   expectField("\"RLEG_JOINT0\"", "\"RLEG_JOINT9\"", "joint_names[0]");
+  Plan set = threeStancePlan();
+  set.planner_settings = {"max_nodes=3"};
+  test::expectBadField([&](const std::string& t) { planFromJson(t, "plan.json", sc); }, planToJson(set, sc),
+                       "plan.json", "\"max_nodes=3\"", "3", "planner_settings[0]");
   EXPECT_THROW(planFromJson("{\"format\": ", "plan.json", sc), FormatError);
 }
 

@@ -108,6 +108,7 @@ std::string planToJson(const Plan& plan, const Scenario& sc) {
   j["format"] = "acyclic.plan/1";
   j["scenario"] = plan.scenario;
   j["robot"] = plan.robot;
+  if (!plan.planner_settings.empty()) j["planner_settings"] = plan.planner_settings;
   j["joint_names"] = sc.robot->jointNames();
   j["stances"] = json::array();
   for (const auto& s : plan.stances) {
@@ -150,6 +151,10 @@ Plan planFromJson(const std::string& text, const std::string& origin, const Scen
   Plan plan;
   plan.scenario = root.has("scenario") ? root.at("scenario").string() : "";
   plan.robot = root.has("robot") ? root.at("robot").string() : "";
+  if (root.has("planner_settings")) {
+    const J settings = root.at("planner_settings");
+    for (std::size_t i = 0; i < settings.size(); ++i) plan.planner_settings.push_back(settings.item(i).string());
+  }
   json_field::checkJointNames(root.at("joint_names"), sc);
   const J stances = root.at("stances");
   for (std::size_t si = 0; si < stances.size(); ++si) {

@@ -32,6 +32,11 @@ struct PlanStats {
 struct Plan {
   std::string scenario;   // the scenario file it answers (as given to the planner)
   std::string robot;      // the robot description it uses
+  // The planner-section keys given on the planner's command line (`--set
+  // KEY=VALUE`, in order), which its scenario file does not hold: the
+  // interpolator applies them before its own, so that the plan is
+  // interpolated as it was verified. Empty: the file's keys alone.
+  std::vector<std::string> planner_settings;
   std::vector<PlanStance> stances;
   PlanStats stats;
 };

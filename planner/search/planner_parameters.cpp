@@ -146,19 +146,19 @@ std::vector<std::string> plannerKeys() {
   return allowed;
 }
 
-// "KEY=VALUE" as the key and VALUE read as YAML (FormatError naming --set).
-std::pair<std::string, YAML::Node> parseSetting(const std::string& setting) {
+// "KEY=VALUE" as the key and VALUE read as YAML (FormatError naming origin).
+std::pair<std::string, YAML::Node> parseSetting(const std::string& setting, const std::string& origin) {
   const auto eq = setting.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw FormatError("--set", "", "expected KEY=VALUE (a key of the scenario's planner section, docs/design.md "
+    throw FormatError(origin, "", "expected KEY=VALUE (a key of the scenario's planner section, docs/design.md "
                                    "section 5), got '" + setting + "'");
   const std::string key = setting.substr(0, eq);
   if (eq + 1 == setting.size())
-    throw FormatError("--set", "planner." + key, "expected a value after '=' (null to drop the scenario's own)");
+    throw FormatError(origin, "planner." + key, "expected a value after '=' (null to drop the scenario's own)");
   try {
     return {key, YAML::Load(setting.substr(eq + 1))};
   } catch (const YAML::Exception& e) {
-    throw FormatError("--set", "planner." + key, "expected a YAML value, got '" + setting.substr(eq + 1) +
+    throw FormatError(origin, "planner." + key, "expected a YAML value, got '" + setting.substr(eq + 1) +
                                                      "' (" + e.msg + ")");
   }
 }
@@ -173,14 +173,15 @@ PlannerParameters parametersOf(const YamlField& f) {
 }
 
 // The settings as (key, value), each read on its own as the scenario's keys
-// are (a bad one is a FormatError naming --set and its field).
-std::vector<std::pair<std::string, YAML::Node>> checkedSettings(const std::vector<std::string>& settings) {
+// are (a bad one is a FormatError naming origin and its field).
+std::vector<std::pair<std::string, YAML::Node>> checkedSettings(const std::vector<std::string>& settings,
+                                                                const std::string& origin) {
   std::vector<std::pair<std::string, YAML::Node>> out;
   for (const std::string& setting : settings) {
-    auto [key, value] = parseSetting(setting);
+    auto [key, value] = parseSetting(setting, origin);
     YAML::Node alone(YAML::NodeType::Map);
     alone[key] = value;
-    const YamlField f(alone, "--set", "planner");
+    const YamlField f(alone, origin, "planner");
     if (value.IsNull()) f.allowOnly(plannerKeys());  // a key to drop: only its name to check
     else parametersOf(f);
     out.emplace_back(std::move(key), std::move(value));
@@ -211,11 +212,13 @@ void keepPortfolioMember(PlannerParameters& p, const std::string& name, const st
                               ")");
 }
 
-void checkPlannerSettings(const std::vector<std::string>& settings) { checkedSettings(settings); }
+void checkPlannerSettings(const std::vector<std::string>& settings, const std::string& origin) {
+  checkedSettings(settings, origin);
+}
 
-void setPlannerKeys(Scenario& sc, const std::vector<std::string>& settings) {
+void setPlannerKeys(Scenario& sc, const std::vector<std::string>& settings, const std::string& origin) {
   if (settings.empty()) return;
-  const auto checked = checkedSettings(settings);  // all of them before any is set
+  const auto checked = checkedSettings(settings, origin);  // all of them before any is set
   YAML::Node section = sc.planner_section ? YAML::Clone(sc.planner_section->node()) : YAML::Node(YAML::NodeType::Map);
   for (const auto& [key, value] : checked) {
     if (value.IsNull()) section.remove(key);

@@ -22,12 +22,12 @@ void keepPortfolioMember(PlannerParameters& p, const std::string& name, const st
 // a list of maps for `portfolio`), null (or ~) dropping the key so that its default
 // applies. checkPlannerSettings reads each on its own, as the scenario's own
 // keys are read: a setting that is not KEY=VALUE, names no planner key, or
-// holds a bad value is a FormatError naming "--set" and the field.
-// setPlannerKeys (which checks them first) puts them in the scenario's
-// planner section, in order, as if its file said so: every reader of the
-// section (the search, the verification of transitions, the interpolator's
-// margins) sees them.
-void checkPlannerSettings(const std::vector<std::string>& settings);
-void setPlannerKeys(Scenario& sc, const std::vector<std::string>& settings);
+// holds a bad value is a FormatError naming `origin` ("--set", or the plan
+// file that recorded them) and the field. setPlannerKeys (which checks them
+// first) puts them in the scenario's planner section, in order, as if its
+// file said so: every reader of the section (the search, the verification
+// of transitions, the interpolator's margins) sees them.
+void checkPlannerSettings(const std::vector<std::string>& settings, const std::string& origin = "--set");
+void setPlannerKeys(Scenario& sc, const std::vector<std::string>& settings, const std::string& origin = "--set");
 
 }  // namespace acyclic
