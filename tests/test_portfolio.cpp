@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <thread>
 
@@ -322,6 +323,80 @@ TEST(Portfolio, TraceLinesNameTheirMember) {
     EXPECT_TRUE(l.rfind("[as configured] ", 0) == 0 || l.rfind("[coarser] ", 0) == 0) << l;
 }
 
+// In sequence (portfolio_mode: sequence): the first member that solves
+// answers, with the very plan it makes alone, and the members after it are
+// not run.
+TEST(Portfolio, InSequenceTheFirstMemberThatSolvesAnswersAndTheRestDoNotRun) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  const PlanningResult alone = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(alone.solved()) << alone.reason;
+  p.portfolio_mode = PlannerParameters::PortfolioMode::Sequence;
+  p.portfolio = {asConfigured(), coarser()};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 0);
+  ASSERT_EQ(r.members.size(), 1u);  // "coarser" never ran
+  EXPECT_EQ(r.members[0].name, "as configured");
+  EXPECT_EQ(json(r, sc), json(alone, sc));
+  EXPECT_EQ(r.stats.searchCalls(), alone.stats.searchCalls());
+  EXPECT_EQ(r.portfolioNodes(), alone.stats.nodes_generated);
+}
+
+// A member that ends without a plan (its own node budget here) hands over
+// to the next, whose plan is its own alone; none solving, the last one's
+// status and every member's reason.
+TEST(Portfolio, InSequenceAMemberOutOfItsBudgetHandsOverToTheNext) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  const PlanningResult alone = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(alone.solved()) << alone.reason;
+  ASSERT_GT(alone.stats.nodes_generated, 3);
+  p.portfolio_mode = PlannerParameters::PortfolioMode::Sequence;
+  p.portfolio = {{"three nodes", [](PlannerParameters& q) { q.max_nodes = 3; }}, asConfigured()};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 1);
+  ASSERT_EQ(r.members.size(), 2u);
+  EXPECT_EQ(r.members[0].status, PlanningResult::Status::NodeBudget) << r.members[0].reason;
+  EXPECT_EQ(r.members[0].stats.nodes_generated, 3);
+  EXPECT_EQ(json(r, sc), json(alone, sc));
+  EXPECT_EQ(r.portfolioNodes(), 3 + alone.stats.nodes_generated);
+
+  p.portfolio = {{"one contact", [](PlannerParameters& q) { q.max_contacts = 1; }},
+                 {"three nodes", [](PlannerParameters& q) { q.max_nodes = 3; }}};
+  const PlanningResult none = ContactPlanner(sc, p).plan();
+  EXPECT_FALSE(none.solved());
+  EXPECT_EQ(none.winner, -1);
+  ASSERT_EQ(none.members.size(), 2u);
+  EXPECT_EQ(none.status, PlanningResult::Status::NodeBudget);  // the last member's
+  EXPECT_NE(none.reason.find("one contact: "), std::string::npos) << none.reason;
+  EXPECT_NE(none.reason.find("three nodes: "), std::string::npos) << none.reason;
+  EXPECT_TRUE(none.plan.stances.empty());
+}
+
+// The time budget bounds the sequence, not each member: a member that
+// spends it (here one that would run for minutes: every plan refused, 30 ms
+// per expansion, its own max_seconds 600) ends on it, and the next is not run.
+TEST(Portfolio, InSequenceTheMembersShareTheTimeBudget) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  p.max_seconds = 1.0;
+  p.portfolio_mode = PlannerParameters::PortfolioMode::Sequence;
+  p.portfolio = {{"refusing", [](PlannerParameters& q) {
+                    refuseEveryPlan(q);
+                    slowDown(q);
+                  }},
+                 asConfigured()};
+  const auto t0 = std::chrono::steady_clock::now();
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_FALSE(r.solved());
+  EXPECT_EQ(r.status, PlanningResult::Status::TimeLimit) << r.reason;
+  ASSERT_EQ(r.members.size(), 1u);
+  EXPECT_LT(seconds, 30.0);  // not the member's own 600 s (nor the slowed search's end)
+}
+
 TEST(Portfolio, ReadFromTheScenarioWithNamedErrors) {
   test::TempDir dir;
   const std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
@@ -339,11 +414,26 @@ TEST(Portfolio, ReadFromTheScenarioWithNamedErrors) {
   p.portfolio[1].apply(q);
   EXPECT_DOUBLE_EQ(q.duplicate_distance, 0.1);
   EXPECT_EQ(q.posture.distance_engine, DistanceEngine::Convex);
+  EXPECT_EQ(p.portfolio_mode, PlannerParameters::PortfolioMode::Race);  // by default
+  // A sequence, its first member with its own budgets.
+  const Scenario seq = Scenario::load(dir.write(
+      "b.yaml", text + "planner: {max_nodes: 900, portfolio_mode: sequence, portfolio: [{max_nodes: 7, "
+                       "max_posture_calls: 11}, {}]}\n"));
+  const PlannerParameters ps = plannerParameters(seq);
+  EXPECT_EQ(ps.portfolio_mode, PlannerParameters::PortfolioMode::Sequence);
+  PlannerParameters first = ps, second = ps;
+  ps.portfolio[0].apply(first);
+  ps.portfolio[1].apply(second);
+  EXPECT_EQ(first.max_nodes, 7);
+  EXPECT_EQ(first.max_posture_calls, 11);
+  EXPECT_EQ(second.max_nodes, 900);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {portfolio: [{}]}\n", "planner.portfolio"},
            {"planner: {portfolio: {a: 1}}\n", "planner.portfolio"},
            {"planner: {portfolio: [{}, 3]}\n", "planner.portfolio[1]"},
-           {"planner: {portfolio: [{}, {max_nodes: 5}]}\n", "planner.portfolio[1].max_nodes"},
+           {"planner: {portfolio: [{}, {max_nodes: 0}]}\n", "planner.portfolio[1].max_nodes"},
+           {"planner: {portfolio: [{}, {portfolio_mode: race}]}\n", "planner.portfolio[1].portfolio_mode"},
+           {"planner: {portfolio: [{}, {}], portfolio_mode: together}\n", "planner.portfolio_mode"},
            {"planner: {portfolio: [{}, {threads: 1}]}\n", "planner.portfolio[1].threads"},
            {"planner: {portfolio: [{}, {duplicate_distance: -1}]}\n", "planner.portfolio[1].duplicate_distance"},
            {"planner: {portfolio: [{name: a}, {name: a}]}\n", "planner.portfolio[1].name"},

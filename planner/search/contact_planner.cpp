@@ -1028,6 +1028,8 @@ ContactPlanner::ContactPlanner(const Scenario& scenario, PlannerParameters param
 }
 ContactPlanner::~ContactPlanner() = default;
 
+void ContactPlanner::setTimeBudget(double seconds) { impl_->p.max_seconds = seconds; }
+
 PlanningResult ContactPlanner::plan(const std::atomic<bool>* cancel, const Progress& progress) {
   return portfolio_ ? portfolio_->plan(cancel, progress) : search(cancel, progress, nullptr);
 }

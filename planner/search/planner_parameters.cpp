@@ -119,7 +119,8 @@ std::vector<PlannerVariant> portfolioOf(const YamlField& list, const PlannerPara
   if (!list.isSequence() || list.size() < 2)
     list.fail("a list of at least two members, each a map of planner keys to change (an empty map: as configured)");
   std::vector<std::string> allowed = kVariantKeys;
-  allowed.push_back("name");
+  // A member's own budgets: what a sequence gives it before the next (in a race, too).
+  for (const char* key : {"name", "max_nodes", "max_posture_calls"}) allowed.push_back(key);
   std::vector<PlannerVariant> members;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YamlField m = list.at(i);
@@ -141,7 +142,8 @@ std::vector<PlannerVariant> portfolioOf(const YamlField& list, const PlannerPara
 std::vector<std::string> plannerKeys() {
   std::vector<std::string> allowed = kVariantKeys;
   for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_seconds", "verify_transitions",
-                          "verify_on_expansion", "zmp_shift_cap", "transition_mu_oracle", "portfolio"})
+                          "verify_on_expansion", "zmp_shift_cap", "transition_mu_oracle", "portfolio",
+                          "portfolio_mode"})
     allowed.push_back(key);
   return allowed;
 }
@@ -169,6 +171,12 @@ PlannerParameters parametersOf(const YamlField& f) {
   f.allowOnly(plannerKeys());
   readFields(f, p);
   if (f.has("portfolio")) p.portfolio = portfolioOf(f["portfolio"], p);
+  if (f.has("portfolio_mode")) {
+    const std::string v = f["portfolio_mode"].string();
+    if (v != "race" && v != "sequence") f["portfolio_mode"].fail("race or sequence");
+    p.portfolio_mode =
+        v == "race" ? PlannerParameters::PortfolioMode::Race : PlannerParameters::PortfolioMode::Sequence;
+  }
   return p;
 }
 

@@ -91,8 +91,10 @@ void ContactPlanner::MemberLink::gate(long calls, const std::function<bool()>& g
   }
 }
 
-ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerParameters& params) {
+ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerParameters& params)
+    : mode(params.portfolio_mode), max_seconds(params.max_seconds) {
   const int n = static_cast<int>(params.portfolio.size());
+  const bool in_turn = mode == PlannerParameters::PortfolioMode::Sequence;
   // Shared by the members when there is no factory of verifiers, and for
   // the caller's trace: one call at a time.
   auto verify_lock = std::make_shared<std::mutex>();
@@ -115,7 +117,7 @@ ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerPara
     if (v.apply) v.apply(p);
     if (!p.portfolio.empty())
       throw std::invalid_argument("portfolio member \"" + v.name + "\": a member cannot hold a portfolio");
-    p.threads = std::max(1, params.threads / n);
+    p.threads = in_turn ? params.threads : std::max(1, params.threads / n);
     if (p.trace) {
       auto trace = p.trace;
       const std::string prefix = "[" + v.name + "] ";
@@ -129,8 +131,8 @@ ContactPlanner::Portfolio::Portfolio(const Scenario& scenario, const PlannerPara
   }
 }
 
-PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, const Progress& progress) {
-  const auto t0 = std::chrono::steady_clock::now();
+std::vector<PlanningResult> ContactPlanner::Portfolio::race(const std::atomic<bool>* cancel,
+                                                           const Progress& progress) {
   const std::size_t n = members.size();
   PortfolioState state(n);
   std::atomic<bool> stop_all{false};
@@ -171,6 +173,39 @@ PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, 
     }
   }
   for (auto& t : threads) t.join();
+  return results;
+}
+
+std::vector<PlanningResult> ContactPlanner::Portfolio::inTurn(const std::atomic<bool>* cancel,
+                                                             const Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<PlanningResult> results;
+  std::vector<PlanningStats> latest(members.size());
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // A member after one that spent the time budget (or was cancelled) is not run.
+    if (i > 0 && (spent >= max_seconds || (cancel && cancel->load()))) break;
+    // Earlier members' time is spent: each starts with what is left.
+    members[i]->setTimeBudget(max_seconds - spent);
+    auto report = [&, i](const PlanningStats& s) {
+      latest[i] = s;
+      latest[i].seconds += spent;  // the caller's clock: the sequence's
+      if (progress) progress(combined(latest));
+    };
+    results.push_back(members[i]->search(cancel, report, nullptr));
+    latest[i] = results.back().stats;
+    if (results.back().solved()) break;
+  }
+  return results;
+}
+
+PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, const Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<PlanningResult> results =
+      mode == PlannerParameters::PortfolioMode::Sequence ? inTurn(cancel, progress) : race(cancel, progress);
+  const std::size_t n = results.size();
+  std::vector<PlanningStats> latest;
+  for (const PlanningResult& r : results) latest.push_back(r.stats);
 
   int winner = -1;
   for (std::size_t i = 0; i < n; ++i)
@@ -184,9 +219,10 @@ PlanningResult ContactPlanner::Portfolio::plan(const std::atomic<bool>* cancel, 
   if (winner >= 0) {
     out = std::move(results[winner]);
   } else {
-    // None solved: the first member's status (a cancel is every member's),
-    // every member's reason, their counts summed.
-    out.status = results[0].status;
+    // None solved: the first member's status in a race (a cancel is every
+    // member's), the last one's in a sequence (its budget, the time, a
+    // cancel), every member's reason, their counts summed.
+    out.status = mode == PlannerParameters::PortfolioMode::Sequence ? results.back().status : results[0].status;
     for (std::size_t i = 0; i < n; ++i)
       out.reason += (i ? "; " : "") + names[i] + ": " + results[i].reason;
     out.stats = combined(latest);

@@ -1,7 +1,9 @@
 #pragma once
 // The contact planner's portfolio (PlannerParameters::portfolio): one search
 // per member, each on its own thread, and the plan of the member that solved
-// in the fewest posture calls. Private to the planner (contact_planner.cpp).
+// in the fewest posture calls; or (portfolio_mode: sequence) the members one
+// after another, each on every thread, until one solves (what follows is
+// the race's). Private to the planner (contact_planner.cpp).
 //
 // Why posture calls and not nodes: calls are most of a search's time, and
 // members differ in calls per node. On chair_paper's OMPL guide the
@@ -60,8 +62,16 @@ struct ContactPlanner::MemberLink {
 struct ContactPlanner::Portfolio {
   std::vector<std::string> names;
   std::vector<std::unique_ptr<ContactPlanner>> members;
+  PlannerParameters::PortfolioMode mode;
+  double max_seconds;  // a sequence's, all members together
   Portfolio(const Scenario& scenario, const PlannerParameters& params);
   PlanningResult plan(const std::atomic<bool>* cancel, const Progress& progress);
+
+ private:
+  // The members at once (Race) or in turn (Sequence); their results in the
+  // portfolio's order (a sequence's: those that ran).
+  std::vector<PlanningResult> race(const std::atomic<bool>* cancel, const Progress& progress);
+  std::vector<PlanningResult> inTurn(const std::atomic<bool>* cancel, const Progress& progress);
 };
 
 }  // namespace acyclic
