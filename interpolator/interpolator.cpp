@@ -6,9 +6,12 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
+#include <optional>
 #include <thread>
 
 #include "interpolator/stance_filter.h"
+#include "interpolator/transition_memo.h"
 #include "interpolator/time_law.h"
 #include "planner/scene/friction.h"
 
@@ -64,6 +67,12 @@ std::string validateOptions(const InterpolatorOptions& o) {
   return "";
 }
 
+// interpolate(), with a memo or none (nullptr).
+InterpolationResult interpolateWith(const Plan& plan, const Scenario& sc, const InterpolatorOptions& opt,
+                                    TransitionMemo* memo,
+                                    const std::function<void(const InterpolationProgress&)>& progress,
+                                    const std::atomic<bool>* cancel);
+
 }  // namespace
 
 InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions o) {
@@ -112,9 +121,26 @@ TransitionOptions transitionOptions(const InterpolatorOptions& opt) {
   return to;
 }
 
-InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& opt,
+InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& options,
                                 const std::function<void(const InterpolationProgress&)>& progress,
                                 const std::atomic<bool>* cancel) {
+  return interpolateWith(plan, sc, options, nullptr, progress, cancel);
+}
+
+InterpolationResult interpolate(const Plan& plan, const Scenario& sc, TransitionMemo& memo,
+                                const std::function<void(const InterpolationProgress&)>& progress,
+                                const std::atomic<bool>* cancel) {
+  if (!memo.keepsMotion())
+    throw std::invalid_argument("interpolate: the memo keeps no motion (TransitionMemo's keep_motion)");
+  return interpolateWith(plan, sc, memo.options(), &memo, progress, cancel);
+}
+
+namespace {
+
+InterpolationResult interpolateWith(const Plan& plan, const Scenario& sc, const InterpolatorOptions& opt,
+                                    TransitionMemo* memo,
+                                    const std::function<void(const InterpolationProgress&)>& progress,
+                                    const std::atomic<bool>* cancel) {
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   InterpolationResult res;
@@ -200,8 +226,14 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
         }
         const TransitionDesign& d = designs[i];
         auto cached = fr.solved.find({d.from, d.to});
-        TransitionOutcome o = cached != fr.solved.end() ? cached->second : s.solve(plan, d, cancel);
-        const bool counted = cached == fr.solved.end();
+        const std::string key = memo ? transitionKey(plan, d) : std::string();
+        std::optional<TransitionOutcome> remembered;
+        if (cached == fr.solved.end() && memo) remembered = memo->find(key);
+        TransitionOutcome o = cached != fr.solved.end() ? cached->second
+                              : remembered                ? std::move(*remembered)
+                                                          : s.solve(plan, d, cancel);
+        const bool counted = cached == fr.solved.end() && !remembered;
+        if (counted && memo) memo->store(key, o);
         if (o.cancelled) stop = true;
         if (!o.ok && !o.cancelled) {  // first_failed = min(first_failed, i)
           std::size_t f = first_failed.load();
@@ -210,6 +242,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
         }
         std::lock_guard<std::mutex> lock(m);
         if (counted) tr.stats.posture_calls += o.posture_calls, res.posture_seconds += o.posture_seconds;
+        if (remembered) ++res.reused;
         outcomes[i] = std::move(o);
         done[i] = 1;
         pr.transition = static_cast<int>(++finished);
@@ -294,5 +327,7 @@ InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const Inte
   report("done");
   return res;
 }
+
+}  // namespace
 
 }  // namespace acyclic

@@ -16,6 +16,8 @@
 
 namespace acyclic {
 
+class TransitionMemo;  // transition_memo.h
+
 struct InterpolatorOptions {
   int steps = 20;                // n: posture-generator steps per transition (moving body)
   double fixed_step = 0.02;      // fixed-contact transitions: a step per 0.02 rad (m) of change, n at most; 0: n
@@ -102,6 +104,9 @@ struct InterpolationResult {
   // The transitions solved, in the plan's order, up to and with the one that
   // failed (none when the filtering or the design failed first).
   std::vector<TransitionRecord> transitions;
+  // Of those, taken from a memo (transition_memo.h) instead of solved: their
+  // posture calls are not in the trajectory's stats, which count this run's.
+  int reused = 0;
   bool success() const { return status == Status::Success; }
 };
 
@@ -122,6 +127,15 @@ InterpolatorOptions withScenarioMargins(const Scenario& sc, InterpolatorOptions 
 TransitionOptions transitionOptions(const InterpolatorOptions& options);
 
 InterpolationResult interpolate(const Plan& plan, const Scenario& sc, const InterpolatorOptions& options,
+                                const std::function<void(const InterpolationProgress&)>& progress = {},
+                                const std::atomic<bool>* cancel = nullptr);
+
+// The same with the memo's options, each transition the memo holds taken
+// from it instead of solved (InterpolationResult::reused counts them), and
+// each one solved kept there: the same result as above, bit for bit
+// (transition_memo.h). acyclic-planner --trajectory interpolates its plan
+// with the memo its verification of transitions filled.
+InterpolationResult interpolate(const Plan& plan, const Scenario& sc, TransitionMemo& memo,
                                 const std::function<void(const InterpolationProgress&)>& progress = {},
                                 const std::atomic<bool>* cancel = nullptr);
 

@@ -4,44 +4,19 @@
 #include <cstring>
 #include <stdexcept>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 namespace acyclic {
 
-namespace {
-
-void appendBytes(std::string& key, const void* p, std::size_t n) { key.append(static_cast<const char*>(p), n); }
-
-// The exact contents of the stances a transition reads: its key.
-std::string transitionKey(const Plan& plan, const TransitionDesign& d) {
-  std::string key;
-  const int kind = static_cast<int>(d.kind);
-  appendBytes(key, &kind, sizeof kind);
-  for (int k = d.from; k <= d.to; ++k) {
-    const PlanStance& st = plan.stances[static_cast<std::size_t>(k)];
-    const Configuration& q = st.configuration;
-    appendBytes(key, q.base_position.data(), 3 * sizeof(double));
-    appendBytes(key, q.base_orientation.coeffs().data(), 4 * sizeof(double));
-    appendBytes(key, q.joints.data(), static_cast<std::size_t>(q.joints.size()) * sizeof(double));
-    const std::size_t n = st.contacts.size();
-    appendBytes(key, &n, sizeof n);
-    for (const PlanContact& c : st.contacts) {
-      const ContactSpec& s = c.spec;
-      const int ints[3] = {s.spot, s.surface, s.supporting ? 1 : 0};
-      const double place[3] = {s.placement.x, s.placement.y, s.placement.theta};
-      appendBytes(key, ints, sizeof ints);
-      appendBytes(key, place, sizeof place);
-    }
-  }
-  return key;
-}
-
-}  // namespace
-
 TransitionVerifier::TransitionVerifier(const Scenario& sc, const InterpolatorOptions& options)
-    : sc_(std::make_shared<const Scenario>(sc)), options_(transitionOptions(options)) {
-  for (int t = 0; t < std::max(1, options.threads); ++t)
-    solvers_.push_back(std::make_unique<TransitionSolver>(*sc_, options_));
+    : TransitionVerifier(sc, std::make_shared<TransitionMemo>(options, false)) {}
+
+TransitionVerifier::TransitionVerifier(const Scenario& sc, std::shared_ptr<TransitionMemo> memo)
+    : sc_(std::make_shared<const Scenario>(sc)), memo_(std::move(memo)) {
+  const TransitionOptions options = transitionOptions(memo_->options());
+  for (int t = 0; t < std::max(1, memo_->options().threads); ++t)
+    solvers_.push_back(std::make_unique<TransitionSolver>(*sc_, options));
 }
 
 PlanVerdict TransitionVerifier::verify(const Plan& found, const std::atomic<bool>& stop) {
@@ -61,13 +36,16 @@ PlanVerdict TransitionVerifier::verify(const Plan& found, const std::atomic<bool
   }
   v.transitions = static_cast<int>(designs.size());
   const std::size_t nd = designs.size();
+  struct Known {
+    bool ok = false;
+    std::string reason;
+  };
   std::vector<std::string> keys(nd);
   std::vector<Known> outcome(nd);
   std::vector<char> have(nd, 0);
   for (std::size_t i = 0; i < nd; ++i) {
     keys[i] = transitionKey(plan, designs[i]);
-    const auto it = known_.find(keys[i]);
-    if (it != known_.end()) outcome[i] = it->second, have[i] = 1;
+    if (const std::optional<TransitionOutcome> o = memo_->find(keys[i])) outcome[i] = {o->ok, o->reason}, have[i] = 1;
   }
   // The unknown ones, in order, on every solver; none after the first failure.
   std::atomic<std::size_t> next{0}, first_failed{nd};
@@ -90,10 +68,10 @@ PlanVerdict TransitionVerifier::verify(const Plan& found, const std::atomic<bool
         while (i < f && !first_failed.compare_exchange_weak(f, i)) {
         }
       }
+      memo_->store(keys[i], o);
       std::lock_guard<std::mutex> lock(m);
-      outcome[i] = k;
+      outcome[i] = std::move(k);
       have[i] = 1;
-      known_[keys[i]] = std::move(k);
       ++v.solved;
     }
   };
@@ -117,7 +95,11 @@ PlanVerdict TransitionVerifier::verify(const Plan& found, const std::atomic<bool
 }
 
 PlanVerifier makePlanVerifier(const Scenario& sc, const InterpolatorOptions& options) {
-  auto verifier = std::make_shared<TransitionVerifier>(sc, options);
+  return makePlanVerifier(sc, std::make_shared<TransitionMemo>(options, false));
+}
+
+PlanVerifier makePlanVerifier(const Scenario& sc, std::shared_ptr<TransitionMemo> memo) {
+  auto verifier = std::make_shared<TransitionVerifier>(sc, std::move(memo));
   return [verifier](const Plan& plan, const std::atomic<bool>& stop) { return verifier->verify(plan, stop); };
 }
 
@@ -127,6 +109,17 @@ void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const Interpol
     // A portfolio's members each get their own (PlannerParameters::make_verifier).
     auto scenario = std::make_shared<const Scenario>(sc);
     p.make_verifier = [scenario, options] { return makePlanVerifier(*scenario, options); };
+  }
+  if (!p.verify_plan) p.verify_plan = p.make_verifier();
+}
+
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, std::shared_ptr<TransitionMemo> memo) {
+  if (!p.verify_transitions) return;
+  if (!p.make_verifier) {
+    // Each member its own verifier (its own solvers), all keeping what they
+    // solve in the one memo.
+    auto scenario = std::make_shared<const Scenario>(sc);
+    p.make_verifier = [scenario, memo] { return makePlanVerifier(*scenario, memo); };
   }
   if (!p.verify_plan) p.verify_plan = p.make_verifier();
 }

@@ -17,6 +17,7 @@
 #include "interpolator/body_path_planner.h"
 #include "interpolator/interpolator.h"
 #include "interpolator/plan_verifier.h"
+#include "interpolator/transition_memo.h"
 #include "interpolator/limb_path_planner.h"
 #include "interpolator/time_law.h"
 #include "planner/check/trajectory_check.h"
@@ -1349,6 +1350,63 @@ TEST(PlanVerifier, RefusesWhatTheInterpolatorCannotDoAndRemembersWhatItSolved) {
   const PlanVerdict stopped = fresh.verify(plan, stop);
   EXPECT_TRUE(stopped.stopped);
   EXPECT_FALSE(stopped.ok());
+}
+
+// A memo shared by the verifier and the interpolator (transition_memo.h):
+// what the verifier solved is taken from it, none solved again, and the
+// trajectory is the one interpolating from scratch gives, bit for bit. An
+// empty memo is filled by the interpolation itself; one that keeps no
+// motion (a verifier's own) cannot be interpolated with.
+TEST(TransitionMemo, AVerifiedPlanIsInterpolatedWithoutSolvingItsTransitionsAgain) {
+  const Scenario& sc = floorScenario();
+  InterpolatorOptions opt;
+  opt.steps = 8;
+  // As the planner's file holds it: the plan the verifier solves.
+  const Plan plan = planFromJson(planToJson(stepPlan(sc, 0.15), sc), "round trip", sc);
+  const InterpolationResult fresh = interpolate(plan, sc, opt);
+  ASSERT_TRUE(fresh.success()) << fresh.reason;
+  ASSERT_GT(fresh.trajectory.stats.posture_calls, 0);
+  EXPECT_EQ(fresh.reused, 0);
+  auto same = [&](const InterpolationResult& r) {
+    ASSERT_EQ(r.trajectory.samples.size(), fresh.trajectory.samples.size());
+    ASSERT_EQ(r.trajectory.phases.size(), fresh.trajectory.phases.size());
+    for (std::size_t i = 0; i < r.trajectory.samples.size(); ++i) {
+      ASSERT_EQ(r.trajectory.samples[i].q.joints, fresh.trajectory.samples[i].q.joints) << i;
+      ASSERT_EQ(r.trajectory.samples[i].q.base_position, fresh.trajectory.samples[i].q.base_position) << i;
+      ASSERT_EQ(r.trajectory.samples[i].q.base_orientation.coeffs(),
+                fresh.trajectory.samples[i].q.base_orientation.coeffs()) << i;
+      ASSERT_EQ(r.trajectory.samples[i].dq, fresh.trajectory.samples[i].dq) << i;
+    }
+  };
+
+  auto memo = std::make_shared<TransitionMemo>(opt);
+  TransitionVerifier verifier(sc, memo);
+  std::atomic<bool> stop{false};
+  const PlanVerdict v = verifier.verify(plan, stop);
+  ASSERT_TRUE(v.ok()) << v.reason;
+  EXPECT_EQ(v.solved, fresh.trajectory.stats.transitions);
+  EXPECT_EQ(memo->size(), static_cast<std::size_t>(v.solved));
+  const InterpolationResult reused = interpolate(plan, sc, *memo);
+  ASSERT_TRUE(reused.success()) << reused.reason;
+  EXPECT_EQ(reused.reused, reused.trajectory.stats.transitions);
+  EXPECT_EQ(reused.trajectory.stats.posture_calls, 0);
+  same(reused);
+
+  // An empty memo: solved here, kept, then taken.
+  TransitionMemo empty(opt);
+  const InterpolationResult first = interpolate(plan, sc, empty);
+  ASSERT_TRUE(first.success()) << first.reason;
+  EXPECT_EQ(first.reused, 0);
+  EXPECT_EQ(first.trajectory.stats.posture_calls, fresh.trajectory.stats.posture_calls);
+  EXPECT_EQ(empty.size(), static_cast<std::size_t>(first.trajectory.stats.transitions));
+  const InterpolationResult second = interpolate(plan, sc, empty);
+  EXPECT_EQ(second.reused, second.trajectory.stats.transitions);
+  same(first);
+  same(second);
+
+  // A verifier's own memo keeps verdicts, not motion.
+  TransitionMemo lean(opt, false);
+  EXPECT_THROW(interpolate(plan, sc, lean), std::invalid_argument);
 }
 
 namespace {

@@ -1,0 +1,53 @@
+#pragma once
+// Transitions solved once, kept whole (their motion pieces), for one set of
+// interpolator options: the plan verifier (plan_verifier.h) stores every
+// transition it solves there, and interpolate() given the same memo takes a
+// transition from it instead of solving it again. So a plan verified by the
+// planner is interpolated in the same process without solving its
+// transitions twice (acyclic-planner --trajectory).
+//
+// A transition's outcome depends only on the stances it reads and the
+// options: the interpolator's result does not depend on which solver solved
+// what before, nor on the number of threads (bench_interpolator checks it).
+// Keyed by the stances' exact contents (transitionKey), a memo's outcome is
+// the one solving it again would give, bit for bit. The options travel with
+// the memo, so that nothing can look a transition up under other options.
+#include <cstddef>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "interpolator/interpolator.h"
+
+namespace acyclic {
+
+class TransitionMemo {
+ public:
+  // `keep_motion`: keep each outcome's motion pieces (for interpolate());
+  // without, only whether it was made and why not (what a verifier alone
+  // needs: a search that verifies on expansion solves thousands).
+  explicit TransitionMemo(InterpolatorOptions options, bool keep_motion = true)
+      : options_(std::move(options)), keep_motion_(keep_motion) {}
+  bool keepsMotion() const { return keep_motion_; }
+  // The options every transition here was solved with.
+  const InterpolatorOptions& options() const { return options_; }
+  // Thread-safe: a portfolio's members verify at once.
+  std::optional<TransitionOutcome> find(const std::string& key) const;
+  // A cancelled solve is not an outcome: not stored.
+  void store(const std::string& key, const TransitionOutcome& outcome);
+  std::size_t size() const;
+
+ private:
+  const InterpolatorOptions options_;
+  const bool keep_motion_;
+  mutable std::mutex mutex_;
+  std::map<std::string, TransitionOutcome> known_;
+};
+
+// The exact contents of the stances transition `d` of `plan` reads (its
+// kind, and from its first stance to its last each witness's coordinates
+// and contacts, bit for bit): its key in a memo.
+std::string transitionKey(const Plan& plan, const TransitionDesign& d);
+
+}  // namespace acyclic
