@@ -2,6 +2,8 @@
 //   File mode (--in SCENARIO --out PLAN): writes acyclic.plan/1. Progress on
 //   stderr on a terminal, nothing when not. Exit: 0 solved, 1 not solved
 //   (reason printed) or a refused plan not written (--keep-refused), 2 bad input.
+//   --trajectory T: the plan interpolated too, reusing the transitions its
+//   verification solved (exit 1 when no trajectory is made; the plan stays).
 //   LCM mode (--lcm): serves ACYCLIC_REQUEST, answers ACYCLIC_PLAN, reports on
 //   ACYCLIC_PROGRESS and ACYCLIC_STATUS, obeys ACYCLIC_CANCEL (planner_service).
 #include <CLI/CLI.hpp>
@@ -18,6 +20,50 @@
 #include "planner/search/refused_plans.h"
 #include "processes/lcm_process.h"
 #include "processes/planner_service.h"
+
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+#include "interpolator/transition_memo.h"
+#include "planner/plan/trajectory.h"
+
+namespace {
+
+// --trajectory: the plan file just written, read back as acyclic-interpolator
+// reads it (the JSON round trip that the verification also made, so its
+// transitions are found in the memo), interpolated with the memo's options
+// (the scenario's margins and oracle, after --set: what acyclic-interpolator
+// applies from the plan's planner_settings), written to `path`. False, with
+// the reason printed, when no trajectory is made; the plan stays written.
+bool writeTrajectoryOf(const std::string& plan_path, const std::string& scenario_path, const std::string& path,
+                       acyclic::TransitionMemo& memo, bool tty) {
+  const acyclic::Scenario sc = acyclic::Scenario::load(scenario_path);
+  const acyclic::Plan plan = acyclic::readPlan(plan_path, sc);
+  auto progress = [&](const acyclic::InterpolationProgress& p) {
+    if (!tty) return;
+    std::fprintf(stderr, "\r%7.1f s  interpolating: %-11s transition %d of %d   ", p.seconds, p.stage.c_str(),
+                 p.transition, p.transitions);
+  };
+  acyclic::InterpolationResult r = acyclic::interpolate(plan, sc, memo, progress, &acyclic::proc::stopFlag());
+  if (tty) std::fprintf(stderr, "\n");
+  if (!r.success()) {
+    std::printf("acyclic-planner: no trajectory: %s: %s (the plan is written: acyclic-interpolator --in %s)\n",
+                acyclic::toString(r.status), r.reason.c_str(), plan_path.c_str());
+    return false;
+  }
+  r.trajectory.plan = plan_path;
+  r.trajectory.scenario = scenario_path;
+  acyclic::writeTrajectory(r.trajectory, sc, path);
+  const auto& s = r.trajectory.stats;
+  std::printf("acyclic-planner: trajectory: %d stances (%d filtered), %d transitions (%d of them verified by the "
+              "search, not solved again), %d repaired, %ld posture calls, %.2f s\n",
+              s.stances_in, r.filtered, s.transitions, r.reused, s.repairs, s.posture_calls, s.seconds);
+  std::printf("acyclic-planner: %zu samples (%.2f s of motion at dt %.3f s), %zu phases written to %s\n",
+              r.trajectory.samples.size(), r.trajectory.duration(), r.trajectory.dt, r.trajectory.phases.size(),
+              path.c_str());
+  return true;
+}
+
+}  // namespace
+#endif
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -87,6 +133,15 @@ int main(int argc, char** argv) {
                  "stances A..B to DIR/refused_N_stances_A-B.plan.json (give that to acyclic-interpolator --no-filter "
                  "for the whole reason); DIR is created")
       ->type_name("DIR");
+  std::string trajectory_out;
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+  app.add_option("--trajectory", trajectory_out,
+                 "file mode: also interpolate the plan written, as acyclic-interpolator --in PLAN would with no "
+                 "options (the same trajectory, bit for bit), and write acyclic.trajectory/1 here; the transitions "
+                 "the verification solved are not solved again")
+      ->type_name("TRAJECTORY")
+      ->check(acyclic::proc::InWritableDirectory());
+#endif
   app.add_flag("-q,--quiet", quiet, "no progress, even on a terminal");
   app.add_flag("-v,--verbose", o.verbose, "one line per expanded node on stderr (its contacts, key, goal link)");
   ACYCLIC_PARSE_COMMAND_LINE(app, argc, argv)
@@ -104,8 +159,8 @@ int main(int argc, char** argv) {
 
   acyclic::proc::installSignalHandlers();
   if (lcm_mode) {
-    if (!in.empty() || !out.empty() || !keep_refused.empty()) {
-      std::fprintf(stderr, "acyclic-planner: --lcm and --in/--out/--keep-refused exclude each other\n");
+    if (!in.empty() || !out.empty() || !keep_refused.empty() || !trajectory_out.empty()) {
+      std::fprintf(stderr, "acyclic-planner: --lcm and --in/--out/--keep-refused/--trajectory exclude each other\n");
       return 2;
     }
     return acyclic::servePlanner(url, o);
@@ -122,7 +177,12 @@ int main(int argc, char** argv) {
                    "(acyclic-guide writes one) or write them in the scenario\n", in.c_str());
       return 2;
     }
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+    std::shared_ptr<acyclic::TransitionMemo> memo;
+    acyclic::PlannerParameters p = o.apply(sc, -1, trajectory_out.empty() ? nullptr : &memo);
+#else
     acyclic::PlannerParameters p = o.apply(sc, -1);
+#endif
     if (!keep_refused.empty()) {
       // Made before the search, so that a bad path is said now, not after it.
       std::error_code ec;
@@ -190,9 +250,13 @@ int main(int argc, char** argv) {
     if (!r.members.empty())
       std::printf("acyclic-planner: portfolio: %ld nodes generated by the %zu member%s that ran\n", r.portfolioNodes(),
                   r.members.size(), r.members.size() == 1 ? "" : "s");
+    bool trajectory_made = true;
     if (r.solved()) {
       acyclic::writePlan(r.plan, sc, out);
       std::printf("acyclic-planner: %zu stances written to %s\n", r.plan.stances.size(), out.c_str());
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+      if (memo) trajectory_made = writeTrajectoryOf(out, in, trajectory_out, *memo, tty);
+#endif
     } else {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
     }
@@ -209,7 +273,7 @@ int main(int argc, char** argv) {
         kept_all = false;
       }
     }
-    return r.solved() && kept_all ? 0 : 1;
+    return r.solved() && kept_all && trajectory_made ? 0 : 1;
   } catch (const acyclic::FormatError& e) {
     std::fprintf(stderr, "acyclic-planner: %s\n", e.what());
     return 2;

@@ -29,7 +29,8 @@ constexpr bool kVerifyTransitionsByDefault = false;  // nothing to verify with
 #endif
 }  // namespace
 
-PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s) const {
+PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s,
+                                          std::shared_ptr<TransitionMemo>* memo) const {
   setPlannerKeys(sc, set);
   if (seed >= 0) sc.seed = static_cast<std::uint64_t>(seed);
   PlannerParameters p = plannerParameters(sc);
@@ -52,10 +53,16 @@ PlannerParameters PlannerOverrides::apply(Scenario& sc, double request_budget_s)
   else if (!scenario_says) p.verify_transitions = kVerifyTransitionsByDefault;
   if (verify_on_expansion >= 0) p.verify_on_expansion = verify_on_expansion == 1;
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
-  attachPlanVerifier(p, sc);
+  if (memo) {
+    *memo = std::make_shared<TransitionMemo>(withScenarioMargins(sc, {}));
+    attachPlanVerifier(p, sc, *memo);
+  } else {
+    attachPlanVerifier(p, sc);
+  }
 #else
   if (p.verify_transitions)
     throw std::invalid_argument("verify_transitions: this build has no interpolator to verify transitions with");
+  if (memo) throw std::invalid_argument("this build has no interpolator to make a trajectory with");
 #endif
   if (verbose) p.trace = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   return p;

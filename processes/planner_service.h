@@ -1,12 +1,15 @@
 #pragma once
 // The contact planner on LCM: ACYCLIC_REQUEST in, ACYCLIC_PLAN out, with
 // progress, status and cancellation (docs/design.md section 2).
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "planner/search/contact_planner.h"
 
 namespace acyclic {
+
+class TransitionMemo;  // interpolator/transition_memo.h
 
 // Command-line overrides of a scenario's planner parameters (both modes).
 struct PlannerOverrides {
@@ -25,7 +28,12 @@ struct PlannerOverrides {
   // The scenario's parameters with these overrides; a request's time budget
   // (> 0) applies unless --max-seconds is given. Also sets sc.seed. With
   // verify_transitions, the interpolator's verifier (built only with it).
-  PlannerParameters apply(Scenario& sc, double request_budget_s) const;
+  // `memo` (file mode's --trajectory): given, a memo of the interpolator's
+  // options for this scenario (withScenarioMargins) is made there, keeping
+  // motion, and the verification keeps every transition it solves in it, so
+  // that interpolate(plan, sc, *memo) solves none of them again.
+  PlannerParameters apply(Scenario& sc, double request_budget_s,
+                          std::shared_ptr<TransitionMemo>* memo = nullptr) const;
 };
 
 // Serves until SIGINT/SIGTERM. Returns the process's exit status.

@@ -195,3 +195,53 @@ TEST(AcyclicPlanner, APortfolioWritesItsWinnersPlanAndSaysEachMembersOutcome) {
   EXPECT_EQ(stances(dir.path() + "/seq.json"), stances(dir.path() + "/fine.json"));
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/none.json"));
 }
+
+// --trajectory: the plan interpolated in the same run, from the transitions
+// its verification solved (none solved again), gives the trajectory
+// acyclic-interpolator makes from the plan file: the same samples and
+// phases, bit for bit (only the stats, which count this run's work, differ).
+TEST(AcyclicPlanner, TrajectoryInterpolatesThePlanWithTheTransitionsItsVerificationSolved) {
+  acyclic::test::TempDir dir;
+  const std::string s = sourcePath("models/scenarios/step_forward.yaml");
+  const auto run = plan(s, dir.path() + "/p.json", "--trajectory " + dir.path() + "/t1.json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const std::size_t said = run.output.find("of them verified by the search, not solved again");
+  ASSERT_NE(said, std::string::npos) << run.output;
+  // "N transitions (N of them ...": every one reused, and no posture call made.
+  const std::string line = run.output.substr(run.output.rfind("trajectory: ", said));
+  int stances = 0, filtered = 0, transitions = 0, reused = 0;
+  ASSERT_EQ(std::sscanf(line.c_str(), "trajectory: %d stances (%d filtered), %d transitions (%d of them", &stances,
+                        &filtered, &transitions, &reused), 4)
+      << line;
+  EXPECT_GT(transitions, 0);
+  EXPECT_EQ(reused, transitions) << line;
+  EXPECT_NE(line.find(" 0 posture calls"), std::string::npos) << line;
+
+  const auto interp = runProcess(binaryPath("processes/acyclic-interpolator") + " -q --in " + dir.path() +
+                                 "/p.json --out " + dir.path() + "/t2.json");
+  ASSERT_EQ(interp.status, 0) << interp.output;
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_TRUE(j.contains("stats")) << path;
+    j.erase("stats");  // this run's work: differs by design
+    return j;
+  };
+  const nlohmann::json a = read(dir.path() + "/t1.json"), b = read(dir.path() + "/t2.json");
+  ASSERT_FALSE(a.at("samples").empty());
+  EXPECT_TRUE(a == b) << "the planner's trajectory differs from acyclic-interpolator's on the same plan";
+
+  // Without verification nothing is remembered: every transition solved here.
+  const auto unverified =
+      plan(s, dir.path() + "/p3.json", "--no-verify-transitions --trajectory " + dir.path() + "/t3.json");
+  ASSERT_EQ(unverified.status, 0) << unverified.output;
+  EXPECT_NE(unverified.output.find("(0 of them verified by the search"), std::string::npos) << unverified.output;
+  nlohmann::json c = read(dir.path() + "/t3.json"), b_other_plan = b;
+  c.erase("plan");  // the plan file it names: p3.json
+  b_other_plan.erase("plan");
+  EXPECT_TRUE(c == b_other_plan);
+
+  // File mode's: with --lcm it is bad input.
+  const auto lcm = runProcess(binaryPath("processes/acyclic-planner") + " --lcm --trajectory " + dir.path() + "/t.json");
+  EXPECT_EQ(lcm.status, 2) << lcm.output;
+}
