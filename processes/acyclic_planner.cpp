@@ -169,6 +169,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "acyclic-planner: give --in SCENARIO --out PLAN (file mode) or --lcm; see --help\n");
     return 2;
   }
+  if (!trajectory_out.empty() &&
+      std::filesystem::weakly_canonical(trajectory_out) == std::filesystem::weakly_canonical(out)) {
+    std::fprintf(stderr, "acyclic-planner: --trajectory %s is the plan file (--out): give another\n",
+                 trajectory_out.c_str());
+    return 2;
+  }
   try {
     acyclic::Scenario sc = acyclic::Scenario::load(in);
     if (!guide_path.empty()) sc.key_postures = acyclic::readGuide(guide_path, sc).key_postures;

@@ -241,6 +241,12 @@ TEST(AcyclicPlanner, TrajectoryInterpolatesThePlanWithTheTransitionsItsVerificat
   b_other_plan.erase("plan");
   EXPECT_TRUE(c == b_other_plan);
 
+  // Not over the plan file: bad input, said before any search.
+  const auto over = plan(s, dir.path() + "/p4.json", "--trajectory " + dir.path() + "/./p4.json");
+  EXPECT_EQ(over.status, 2) << over.output;
+  EXPECT_NE(over.output.find("is the plan file"), std::string::npos) << over.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/p4.json"));
+
   // File mode's: with --lcm it is bad input.
   const auto lcm = runProcess(binaryPath("processes/acyclic-planner") + " --lcm --trajectory " + dir.path() + "/t.json");
   EXPECT_EQ(lcm.status, 2) << lcm.output;
