@@ -375,6 +375,40 @@ TEST(Portfolio, InSequenceAMemberOutOfItsBudgetHandsOverToTheNext) {
   EXPECT_TRUE(none.plan.stances.empty());
 }
 
+// max_plateau_nodes: a search whose best guide potential has not fallen for
+// that many nodes stops, saying so, and in a sequence hands over to the
+// next member, whose plan is then the one it makes alone. A bound the
+// search never reaches changes nothing.
+TEST(Portfolio, InSequenceAMemberOnAPlateauHandsOverToTheNext) {
+  const Scenario& sc = step();
+  PlannerParameters p;
+  const PlanningResult alone = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(alone.solved()) << alone.reason;
+  PlannerParameters wide = p;
+  wide.max_plateau_nodes = alone.stats.nodes_generated + 1;
+  EXPECT_EQ(json(ContactPlanner(sc, wide).plan(), sc), json(alone, sc));
+
+  PlannerParameters flat = p;
+  flat.max_plateau_nodes = 1;  // any son that does not lower the best potential
+  const PlanningResult stopped = ContactPlanner(sc, flat).plan();
+  ASSERT_FALSE(stopped.solved()) << "step_forward's search must generate a son no better than the best, or this "
+                                    "tests nothing";
+  EXPECT_EQ(stopped.status, PlanningResult::Status::NodeBudget);
+  EXPECT_NE(stopped.reason.find("since the guide potential last fell (max_plateau_nodes"), std::string::npos)
+      << stopped.reason;
+  EXPECT_LT(stopped.stats.nodes_generated, alone.stats.nodes_generated);
+
+  p.portfolio_mode = PlannerParameters::PortfolioMode::Sequence;
+  p.portfolio = {{"flat", [](PlannerParameters& q) { q.max_plateau_nodes = 1; }}, asConfigured()};
+  const PlanningResult r = ContactPlanner(sc, p).plan();
+  ASSERT_TRUE(r.solved()) << r.reason;
+  EXPECT_EQ(r.winner, 1);
+  ASSERT_EQ(r.members.size(), 2u);
+  EXPECT_EQ(r.members[0].status, PlanningResult::Status::NodeBudget) << r.members[0].reason;
+  EXPECT_EQ(r.members[0].stats.nodes_generated, stopped.stats.nodes_generated);
+  EXPECT_EQ(json(r, sc), json(alone, sc));
+}
+
 // The time budget bounds the sequence, not each member: a member that
 // spends it (here one that would run for minutes: every plan refused, 30 ms
 // per expansion, its own max_seconds 600) ends on it, and the next is not run.
@@ -418,7 +452,7 @@ TEST(Portfolio, ReadFromTheScenarioWithNamedErrors) {
   // A sequence, its first member with its own budgets.
   const Scenario seq = Scenario::load(dir.write(
       "b.yaml", text + "planner: {max_nodes: 900, portfolio_mode: sequence, portfolio: [{max_nodes: 7, "
-                       "max_posture_calls: 11}, {}]}\n"));
+                       "max_posture_calls: 11, max_plateau_nodes: 5}, {}]}\n"));
   const PlannerParameters ps = plannerParameters(seq);
   EXPECT_EQ(ps.portfolio_mode, PlannerParameters::PortfolioMode::Sequence);
   PlannerParameters first = ps, second = ps;
@@ -427,11 +461,15 @@ TEST(Portfolio, ReadFromTheScenarioWithNamedErrors) {
   EXPECT_EQ(first.max_nodes, 7);
   EXPECT_EQ(first.max_posture_calls, 11);
   EXPECT_EQ(second.max_nodes, 900);
+  EXPECT_EQ(first.max_plateau_nodes, 5);
+  EXPECT_EQ(second.max_plateau_nodes, 0);  // by default: no such bound
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"planner: {portfolio: [{}]}\n", "planner.portfolio"},
            {"planner: {portfolio: {a: 1}}\n", "planner.portfolio"},
            {"planner: {portfolio: [{}, 3]}\n", "planner.portfolio[1]"},
            {"planner: {portfolio: [{}, {max_nodes: 0}]}\n", "planner.portfolio[1].max_nodes"},
+           {"planner: {portfolio: [{}, {max_plateau_nodes: -1}]}\n", "planner.portfolio[1].max_plateau_nodes"},
+           {"planner: {max_plateau_nodes: 1.5}\n", "planner.max_plateau_nodes"},
            {"planner: {portfolio: [{}, {portfolio_mode: race}]}\n", "planner.portfolio[1].portfolio_mode"},
            {"planner: {portfolio: [{}, {}], portfolio_mode: together}\n", "planner.portfolio_mode"},
            {"planner: {portfolio: [{}, {threads: 1}]}\n", "planner.portfolio[1].threads"},

@@ -142,6 +142,7 @@ struct ContactPlanner::Impl {
   PlanningStats stats;
   std::chrono::steady_clock::time_point t0;
   long order = 0;
+  long nodes_at_best = 0;  // nodes generated when the best potential last fell (max_plateau_nodes)
   int goal_node = -1;
   std::vector<int> stance_owner;  // exportPlan: the node each stance of the plan comes from
   std::vector<char> stance_settled;  // exportPlan: the stance is a settledWitness (its owner's settled_used)
@@ -211,6 +212,14 @@ struct ContactPlanner::Impl {
     if (stats.nodes_generated >= p.max_nodes) {
       stop = PlanningResult::Status::NodeBudget;
       stop_reason = std::to_string(p.max_nodes) + " nodes generated without reaching the goal";
+      return false;
+    }
+    if (p.max_plateau_nodes > 0 && stats.nodes_generated - nodes_at_best >= p.max_plateau_nodes) {
+      stop = PlanningResult::Status::NodeBudget;
+      stop_reason = std::to_string(stats.nodes_generated - nodes_at_best) +
+                    " nodes generated since the guide potential last fell (max_plateau_nodes; best " +
+                    std::to_string(stats.best_potential) + " at node " + std::to_string(nodes_at_best) +
+                    ") without reaching the goal";
       return false;
     }
     if (stats.posture_calls >= p.max_posture_calls) {
@@ -332,7 +341,10 @@ struct ContactPlanner::Impl {
     open.push({nodes[id].key + p.depth_weight * nodes[id].depth +
                    p.potential_k * p.alternative_step * nodes[id].alternative,
                order++, id});
-    if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) stats.best_potential = nodes[id].key;
+    if (stats.nodes_generated == 1 || nodes[id].key < stats.best_potential) {
+      stats.best_potential = nodes[id].key;
+      nodes_at_best = stats.nodes_generated;
+    }
     return id;
   }
 

@@ -70,6 +70,12 @@ struct PlannerParameters {
   int max_contacts = 6;                // no stance with more contacts
   double reach_slack = 0.3;            // m: trunk and base motion allowed for in the reachability test
   long max_nodes = 1000;               // nodes generated
+  // Nodes generated since the best guide potential of the tree last fell,
+  // at most (0: no such bound): a search on a plateau hands over (a
+  // portfolio in sequence gives the next member the rest of the time).
+  // Counted in nodes, as max_nodes is, so that where a search stops does
+  // not depend on the machine.
+  long max_plateau_nodes = 0;
   long max_posture_calls = 20000;
   double max_seconds = 60;
   bool lazy_sons = true;               // paper 2.8 (false: every son of a node at once)

@@ -54,6 +54,10 @@ void readFields(const YamlField& f, PlannerParameters& p) {
   positive("collision_margin", p.posture.problem.collision_margin);
   count("max_contacts", p.max_contacts);
   count("max_nodes", p.max_nodes);
+  if (f.has("max_plateau_nodes")) {
+    p.max_plateau_nodes = f["max_plateau_nodes"].integer();
+    if (p.max_plateau_nodes < 0) f["max_plateau_nodes"].fail("a count of nodes >= 0 (0: no such bound)");
+  }
   count("max_posture_calls", p.max_posture_calls);
   count("posture_iterations", p.posture.max_iterations);
   count("threads", p.threads);
@@ -120,7 +124,7 @@ std::vector<PlannerVariant> portfolioOf(const YamlField& list, const PlannerPara
     list.fail("a list of at least two members, each a map of planner keys to change (an empty map: as configured)");
   std::vector<std::string> allowed = kVariantKeys;
   // A member's own budgets: what a sequence gives it before the next (in a race, too).
-  for (const char* key : {"name", "max_nodes", "max_posture_calls"}) allowed.push_back(key);
+  for (const char* key : {"name", "max_nodes", "max_posture_calls", "max_plateau_nodes"}) allowed.push_back(key);
   std::vector<PlannerVariant> members;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YamlField m = list.at(i);
@@ -141,7 +145,8 @@ std::vector<PlannerVariant> portfolioOf(const YamlField& list, const PlannerPara
 // Every key of a planner section.
 std::vector<std::string> plannerKeys() {
   std::vector<std::string> allowed = kVariantKeys;
-  for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_seconds", "verify_transitions",
+  for (const char* key : {"threads", "max_nodes", "max_posture_calls", "max_plateau_nodes", "max_seconds",
+                          "verify_transitions",
                           "verify_on_expansion", "zmp_shift_cap", "transition_mu_oracle", "portfolio",
                           "portfolio_mode"})
     allowed.push_back(key);
