@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <stdexcept>
 #include <mutex>
 #include <optional>
@@ -103,25 +104,29 @@ PlanVerifier makePlanVerifier(const Scenario& sc, std::shared_ptr<TransitionMemo
   return [verifier](const Plan& plan, const std::atomic<bool>& stop) { return verifier->verify(plan, stop); };
 }
 
-void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options) {
+namespace {
+
+// Gives p its verifier and, unless it has one, a factory of verifiers (a
+// portfolio's members each get their own, with its own solvers): each made
+// by `make` on a copy of the scenario that outlives the caller's.
+void attachMade(PlannerParameters& p, const Scenario& sc, std::function<PlanVerifier(const Scenario&)> make) {
   if (!p.verify_transitions) return;
   if (!p.make_verifier) {
-    // A portfolio's members each get their own (PlannerParameters::make_verifier).
     auto scenario = std::make_shared<const Scenario>(sc);
-    p.make_verifier = [scenario, options] { return makePlanVerifier(*scenario, options); };
+    p.make_verifier = [scenario, make] { return make(*scenario); };
   }
   if (!p.verify_plan) p.verify_plan = p.make_verifier();
 }
 
+}  // namespace
+
+void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, const InterpolatorOptions& options) {
+  attachMade(p, sc, [options](const Scenario& s) { return makePlanVerifier(s, options); });
+}
+
 void attachPlanVerifier(PlannerParameters& p, const Scenario& sc, std::shared_ptr<TransitionMemo> memo) {
-  if (!p.verify_transitions) return;
-  if (!p.make_verifier) {
-    // Each member its own verifier (its own solvers), all keeping what they
-    // solve in the one memo.
-    auto scenario = std::make_shared<const Scenario>(sc);
-    p.make_verifier = [scenario, memo] { return makePlanVerifier(*scenario, memo); };
-  }
-  if (!p.verify_plan) p.verify_plan = p.make_verifier();
+  // Every member's verifier keeps what it solves in the one memo.
+  attachMade(p, sc, [memo](const Scenario& s) { return makePlanVerifier(s, memo); });
 }
 
 void attachPlanVerifier(PlannerParameters& p, const Scenario& sc) {
