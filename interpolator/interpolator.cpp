@@ -226,9 +226,10 @@ InterpolationResult interpolateWith(const Plan& plan, const Scenario& sc, const 
         }
         const TransitionDesign& d = designs[i];
         auto cached = fr.solved.find({d.from, d.to});
-        const std::string key = memo ? transitionKey(plan, d) : std::string();
+        // Keyed only where the memo is read: not for the filter's own solves.
+        const std::string key = memo && cached == fr.solved.end() ? transitionKey(plan, d) : std::string();
         std::optional<TransitionOutcome> remembered;
-        if (cached == fr.solved.end() && memo) remembered = memo->find(key);
+        if (!key.empty()) remembered = memo->find(key);
         TransitionOutcome o = cached != fr.solved.end() ? cached->second
                               : remembered                ? std::move(*remembered)
                                                           : s.solve(plan, d, cancel);
