@@ -219,10 +219,12 @@ int main(int argc, char** argv) {
     for (acyclic::RefusedPlan& rp : r.refused_plans) rp.plan.planner_settings = o.set;
     if (tty) std::fprintf(stderr, "\n");
     const auto& s = r.stats;
-    std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated, %ld expanded, %ld posture calls (%ld failed), "
-                "%ld pairs skipped by the failure memory, %ld calls solved ahead and not used, %ld stopped early\n",
-                sc.name.c_str(), acyclic::toString(r.status), s.seconds, s.nodes_generated, s.nodes_expanded,
-                s.posture_calls, s.posture_failures, s.pairs_remembered, s.calls_ahead_unused, s.calls_stopped);
+    std::printf("acyclic-planner: %s: %s in %.2f s; %ld nodes generated (%ld dropped as duplicates of a node), "
+                "%ld expanded, %ld posture calls (%ld failed), %ld pairs skipped by the failure memory, %ld calls "
+                "solved ahead and not used, %ld stopped early\n",
+                sc.name.c_str(), acyclic::toString(r.status), s.seconds, s.nodes_generated, s.duplicates,
+                s.nodes_expanded, s.posture_calls, s.posture_failures, s.pairs_remembered, s.calls_ahead_unused,
+                s.calls_stopped);
     if (s.limb_retries > 0)
       std::printf("acyclic-planner: %ld added contacts tried again with the guide's limb, %ld made so\n",
                   s.limb_retries, s.limb_retry_successes);

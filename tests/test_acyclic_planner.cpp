@@ -28,6 +28,9 @@ TEST(AcyclicPlanner, VerifiesThePlansTransitionsByDefaultAndNotWhenToldOtherwise
   ASSERT_EQ(on.status, 0) << on.output;
   EXPECT_NE(on.output.find("transitions verified: 1 plans checked, 0 refused"), std::string::npos) << on.output;
   EXPECT_EQ(on.output.find("by member"), std::string::npos) << on.output;  // no portfolio, no member named
+  // The summary says how many of the nodes generated were dropped as duplicates.
+  EXPECT_NE(on.output.find(" nodes generated ("), std::string::npos) << on.output;
+  EXPECT_NE(on.output.find(" dropped as duplicates of a node), "), std::string::npos) << on.output;
   // The plan it wrote interpolates: the interpolator's own run agrees.
   const auto interp = runProcess(binaryPath("processes/acyclic-interpolator") + " --in " + dir.path() +
                                  "/on.json --out " + dir.path() + "/t.json");

@@ -316,6 +316,26 @@ TEST(ContactPlanner, TheFailureMemorySkipsPairsThatJustFailedFromTheSamePlace) {
   EXPECT_EQ(c.stats.pairs_remembered, a.stats.pairs_remembered);
 }
 
+TEST(ContactPlanner, SonsDroppedAsDuplicatesAreCountedAmongTheNodesGenerated) {
+  // Nodes generated count every son whose posture call succeeded, those
+  // then dropped as too close to a node with the same contacts included
+  // (stats.duplicates, printed by acyclic-planner). Thresholds of nothing
+  // drop none; thresholds of a whole surface drop every son that puts a
+  // contact set back where the tree has it already.
+  const Scenario& sc = step();
+  PlannerParameters none, all;
+  none.duplicate_distance = all.duplicate_distance * 1e-9;
+  none.duplicate_angle = all.duplicate_angle * 1e-9;
+  all.duplicate_distance = 10.0;
+  all.duplicate_angle = 4.0;
+  none.max_nodes = all.max_nodes = 60;
+  const PlanningResult a = ContactPlanner(sc, none).plan();
+  const PlanningResult b = ContactPlanner(sc, all).plan();
+  EXPECT_EQ(a.stats.duplicates, 0);
+  EXPECT_GT(b.stats.duplicates, 0);
+  EXPECT_LT(b.stats.duplicates, b.stats.nodes_generated);
+}
+
 TEST(ContactPlanner, AblationsStillPlanValidly) {
   const Scenario& sc = step();
   for (int which = 0; which < 3; ++which) {

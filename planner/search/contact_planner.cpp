@@ -313,7 +313,10 @@ struct ContactPlanner::Impl {
   // close to it; returns its index or -1. Its key is computed here unless given.
   int addNode(Node n, bool key_given = false) {
     ++stats.nodes_generated;
-    if (isDuplicate(n.contacts)) return -1;
+    if (isDuplicate(n.contacts)) {
+      ++stats.duplicates;
+      return -1;
+    }
     if (!checker.checkPosture(n.q, n.transition).valid()) {
       ++stats.check_refusals;
       return -1;

@@ -165,6 +165,9 @@ struct PlannerParameters {
 struct PlanningStats {
   long nodes_generated = 0, nodes_expanded = 0, posture_calls = 0, posture_failures = 0, check_refusals = 0;
   long pairs_remembered = 0;  // pairs not tried thanks to the failure memory
+  // Of nodes_generated, sons dropped as too close to a node with the same
+  // contacts (duplicate_distance, duplicate_angle), each after its posture call.
+  long duplicates = 0;
   long calls_ahead_unused = 0;  // solved ahead on an idle generator, their turn never came (not in posture_calls)
   // Started ahead like those, and stopped within an iteration when the pair's
   // candidate before them made its son (not in posture_calls either).

@@ -24,6 +24,7 @@ PlanningStats combined(const std::vector<PlanningStats>& all) {
     s.posture_failures += m.posture_failures;
     s.check_refusals += m.check_refusals;
     s.pairs_remembered += m.pairs_remembered;
+    s.duplicates += m.duplicates;
     s.calls_ahead_unused += m.calls_ahead_unused;
     s.calls_stopped += m.calls_stopped;
     s.export_calls += m.export_calls;
