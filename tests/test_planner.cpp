@@ -324,8 +324,8 @@ TEST(ContactPlanner, SonsDroppedAsDuplicatesAreCountedAmongTheNodesGenerated) {
   // contact set back where the tree has it already.
   const Scenario& sc = step();
   PlannerParameters none, all;
-  none.duplicate_distance = all.duplicate_distance * 1e-9;
-  none.duplicate_angle = all.duplicate_angle * 1e-9;
+  none.duplicate_distance = 1e-9;  // m
+  none.duplicate_angle = 1e-9;     // rad
   all.duplicate_distance = 10.0;
   all.duplicate_angle = 4.0;
   none.max_nodes = all.max_nodes = 60;
