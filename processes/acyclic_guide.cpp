@@ -58,6 +58,11 @@ int main(int argc, char** argv) {
                  "with seeds derived from it, each bounded by state checks): less of one random tree's luck")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--path-retries", o.path_retries,
+                 "where none of those tries finds a leg's path within its state checks, this many more (seeded\n"
+                 "the same way) before the leg is given up; a guide whose first try succeeds is unchanged")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   bool no_crouch = false;
   app.add_flag("--no-crouch", no_crouch, "standing postures only: no second try with a crouch");
   bool no_crawl = false;

@@ -237,7 +237,8 @@ TEST(GuideAuthor, SameScenarioAndSeedSameGuide) {
 
 // GuideOptions::path_tries: one RRTConnect try leaves chair_paper's guide to
 // one random tree's luck. Seed 2 finds no path within its 50,000 state checks
-// (the fallback bound of a leg that a crouch may follow); seed 3's path first
+// (the fallback bound of a leg that a crouch may follow; path_retries 0, the
+// next test lifts that); seed 3's path first
 // goes right, behind the chair and round it (x -0.43 m), where the goal is on
 // the left. The shortest of four tries finds a path for both and goes left
 // between the chair and the table each time, the same guide again for the
@@ -246,6 +247,7 @@ TEST(GuideAuthor, TheShortestOfSeveralTriesIsLessOneTreesLuck) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
   GuideOptions one;
   one.max_seconds = 60;  // the check bounds decide, not a loaded machine
+  one.path_retries = 0;
   GuideOptions four = one;
   four.path_tries = 4;
   auto lowestY = [](const Guide& g) {
@@ -267,6 +269,33 @@ TEST(GuideAuthor, TheShortestOfSeveralTriesIsLessOneTreesLuck) {
   ASSERT_TRUE(a.success() && b.success()) << a.reason << " | " << b.reason;
   EXPECT_GT(lowestY(a.guide), -0.05);
   EXPECT_LT(a.guide.key_postures.size(), round.guide.key_postures.size());
+  Guide ga = a.guide, gb = b.guide;
+  ga.seconds = gb.seconds = 0;
+  EXPECT_EQ(guideToJson(ga, sc), guideToJson(gb, sc));
+}
+
+// GuideOptions::path_retries: a leg whose try finds no path within its
+// state checks is tried again with the next seeds before it is given up.
+// chair_paper's seed 2 then has a guide (the retry's tree goes round the
+// chair's right, the long way, as seed 3's first try does); seed 1, whose first try finds its path, has the same guide as without
+// retries, to the bit.
+TEST(GuideAuthor, ALegWhoseTryFindsNoPathIsTriedAgainWithTheNextSeeds) {
+  const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
+  GuideOptions none;
+  none.max_seconds = 60;  // the check bounds decide, not a loaded machine
+  none.path_retries = 0;
+  GuideOptions two = none;
+  two.path_retries = 2;
+  EXPECT_EQ(GuideOptions().path_retries, 1);  // on by default
+  none.seed = two.seed = 2;
+  const GuideResult lost = authorGuide(sc, none);
+  EXPECT_EQ(lost.status, GuideResult::Status::NoPath) << lost.reason;
+  const GuideResult found = authorGuide(sc, two);
+  ASSERT_TRUE(found.success()) << found.reason;
+  EXPECT_GE(found.guide.key_postures.back().base_position.y(), 0.80);  // the waist past the goal's bound
+  none.seed = two.seed = 1;
+  const GuideResult a = authorGuide(sc, none), b = authorGuide(sc, two);
+  ASSERT_TRUE(a.success() && b.success()) << a.reason << " | " << b.reason;
   Guide ga = a.guide, gb = b.guide;
   ga.seconds = gb.seconds = 0;
   EXPECT_EQ(guideToJson(ga, sc), guideToJson(gb, sc));

@@ -873,7 +873,12 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
     // has no such bound), so that the choice is the same under any load.
     std::optional<og::PathGeometric> best;
     bool checks_out = false;  // the first try stopped on its check bound (the leg's, counted from its first check)
-    for (int t = 0; t < std::max(1, o.path_tries) && !(cancel && cancel->load()); ++t) {
+    // GuideOptions::path_retries: more tries, the same way, while none found a path.
+    const int tries = std::max(1, o.path_tries);
+    int made = 0;
+    for (int t = 0; (t < tries || (!best && t < tries + std::max(0, o.path_retries))) && !(cancel && cancel->load());
+         ++t) {
+      ++made;
       try_checks = t == 0 || max_checks > 0 ? max_checks : o.fallback_checks;
       std::optional<og::PathGeometric> p = tryPath(t);
       if (t == 0) checks_out = max_checks > 0 && validity->checks() >= max_checks;
@@ -885,7 +890,7 @@ bool planLeg(const Scenario& sc, const GuideOptions& o, PostureTools& tools, con
       out.status = GuideResult::Status::NoPath;
       out.reason = "OMPL (RRTConnect) found no path to the " + what +
                    (checks_out ? fmt(" within %.0f state checks", max_checks) : fmt(" within %.1f s", budget));
-      if (o.path_tries > 1) out.reason += fmt(" in %.0f tries", o.path_tries);
+      if (made > 1) out.reason += fmt(" in %.0f tries", made);
       if (attempt > 0)
         out.reason += fmt(" through the statically stable subspace (%.0f replans around samples that did not project; "
                           "the last: ", attempt) + unprojected + ")";

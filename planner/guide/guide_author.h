@@ -71,6 +71,17 @@ struct GuideOptions {
   // fallback_checks or go round the chair the long way (docs/design.md
   // section 7).
   int path_tries = 1;
+  // Where none of those tries finds a path within its bound, up to this many
+  // more, each seeded anew as they are and bounded by state checks
+  // (fallback_checks where the leg has no such bound), before the leg is
+  // given up (and a crouch, an approach posture or a crawl is tried). A
+  // guide whose first try finds its path is the same as without them; a
+  // leg that no try can make (under duck_under_beam's beam) costs that many
+  // more bounded tries before its fallback. On chair_paper, seed 2's
+  // standing path was not found within 50,000 checks, the one of seeds 1-60
+  // without a guide; with one retry all 60 have one (docs/design.md
+  // section 7).
+  int path_retries = 1;
   unsigned seed = 1;
 };
 
