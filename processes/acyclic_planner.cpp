@@ -33,10 +33,11 @@ namespace {
 // (the scenario's margins and oracle, after --set: what acyclic-interpolator
 // applies from the plan's planner_settings), written to `path`. False, with
 // the reason printed, when no trajectory is made; the plan stays written.
-// `sc`: the planner's, loaded from `scenario_path` (its robot and scene are
-// what the interpolation reads; its planner keys are in the memo's options).
-bool writeTrajectoryOf(const std::string& plan_path, const acyclic::Scenario& sc, const std::string& scenario_path,
-                       const std::string& path, acyclic::TransitionMemo& memo, bool tty) {
+// `sc`: the planner's (its robot and scene are what the interpolation reads;
+// its planner keys are in the memo's options; its path is the trajectory's
+// scenario, as acyclic-interpolator writes the path it was given).
+bool writeTrajectoryOf(const std::string& plan_path, const acyclic::Scenario& sc, const std::string& path,
+                       acyclic::TransitionMemo& memo, bool tty) {
   const acyclic::Plan plan = acyclic::readPlan(plan_path, sc);
   auto progress = [&](const acyclic::InterpolationProgress& p) {
     if (!tty) return;
@@ -51,7 +52,7 @@ bool writeTrajectoryOf(const std::string& plan_path, const acyclic::Scenario& sc
     return false;
   }
   r.trajectory.plan = plan_path;
-  r.trajectory.scenario = scenario_path;
+  r.trajectory.scenario = sc.path;
   acyclic::writeTrajectory(r.trajectory, sc, path);
   const auto& s = r.trajectory.stats;
   std::printf("acyclic-planner: trajectory: %d stances (%d filtered), %d transitions (%d of them verified by the "
@@ -264,7 +265,7 @@ int main(int argc, char** argv) {
       acyclic::writePlan(r.plan, sc, out);
       std::printf("acyclic-planner: %zu stances written to %s\n", r.plan.stances.size(), out.c_str());
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
-      if (memo) trajectory_made = writeTrajectoryOf(out, sc, in, trajectory_out, *memo, tty);
+      if (memo) trajectory_made = writeTrajectoryOf(out, sc, trajectory_out, *memo, tty);
 #endif
     } else {
       std::printf("acyclic-planner: no plan: %s\n", r.reason.c_str());
