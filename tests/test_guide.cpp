@@ -277,8 +277,9 @@ TEST(GuideAuthor, TheShortestOfSeveralTriesIsLessOneTreesLuck) {
 // GuideOptions::path_retries: a leg whose try finds no path within its
 // state checks is tried again with the next seeds before it is given up.
 // chair_paper's seed 2 then has a guide (the retry's tree goes round the
-// chair's right, the long way, as seed 3's first try does); seed 1, whose first try finds its path, has the same guide as without
-// retries, to the bit.
+// chair's right, the long way, as seed 3's first try does); seed 1, whose
+// first try finds its path, has the same guide as without retries, to the
+// bit.
 TEST(GuideAuthor, ALegWhoseTryFindsNoPathIsTriedAgainWithTheNextSeeds) {
   const Scenario sc = Scenario::load(test::sourcePath("models/scenarios/chair_paper.yaml"));
   GuideOptions none;
