@@ -110,9 +110,13 @@ PostureOptions withMargins() {
 TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
   const Scenario& sc = chair();
   auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
-  for (const PostureOptions& options : {PostureOptions{}, withMargins()}) {
-  SCOPED_TRACE(options.support_inset > 0 ? "with margins" : "without margins");
-  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), options);
+  for (const PostureOptions& options : {PostureOptions{}, withMargins()})
+  for (const bool turned : {false, true}) {  // the floating footprint's rows held half a turn round
+  SCOPED_TRACE(std::string(options.support_inset > 0 ? "with margins" : "without margins") +
+               (turned ? ", footprint turned" : ""));
+  PostureRequest request = wristOnTable(sc);
+  request.floating->footprint_turned = turned;
+  PostureProblem p(sc.robot, sc.scene, cm, request, options);
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0, 0.05);
   for (int trial = 0; trial < 2; ++trial) {
@@ -192,9 +196,13 @@ TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
   // terms, checked loosely) against differences of the constraint Jacobian.
   const Scenario& sc = chair();
   auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
-  for (const PostureOptions& options : {PostureOptions{}, withMargins()}) {
-  SCOPED_TRACE(options.support_inset > 0 ? "with margins" : "without margins");
-  PostureProblem p(sc.robot, sc.scene, cm, wristOnTable(sc), options);
+  for (const PostureOptions& options : {PostureOptions{}, withMargins()})
+  for (const bool turned : {false, true}) {  // the floating footprint's rows held half a turn round
+  SCOPED_TRACE(std::string(options.support_inset > 0 ? "with margins" : "without margins") +
+               (turned ? ", footprint turned" : ""));
+  PostureRequest request = wristOnTable(sc);
+  request.floating->footprint_turned = turned;
+  PostureProblem p(sc.robot, sc.scene, cm, request, options);
   std::mt19937 rng(2);
   std::normal_distribution<double> n(0, 0.05);
   Eigen::VectorXd x = p.initialPoint();
@@ -564,6 +572,57 @@ TEST(PostureGenerator, AFloatingContactsPlacementIsAcceptedAsAFixedContact) {
   const PostureResult b = pg.solve(next);
   EXPECT_NE(b.status, PostureResult::Status::BadInput) << b.reason;
   EXPECT_TRUE(b.success()) << b.reason;
+}
+
+TEST(PostureGenerator, AFloatingSoleKeepsItsOwnFootprintOnASurfaceFacingTheOtherWay) {
+  // The contact rows fix a spot's angle only modulo pi. On a pad whose frame
+  // faces the other way than the robot, the solver's angle starts half a
+  // turn from the sole's and stays there, and the footprint rows held the
+  // sole turned about its ankle: HRP-2's sole reaches 0.14 m ahead of the
+  // ankle and 0.077 m behind, so on this pad 0.24 m long, pulled back
+  // toward where the foot stands, its toe ended 40 mm over the pad's front
+  // edge and the independent check refused the posture. The generator now
+  // solves such a request again with the footprint turned: valid. On the
+  // same pad facing the robot's way one solve is enough.
+  auto padFacing = [](double yaw_deg) {
+    test::TempDir dir;
+    std::string scene = test::readFile(test::sourcePath("models/scenes/open_floor.yaml"));
+    scene += "  - {name: pad, obstacle: floor, position: [0.22, -0.095, 0], rpy_deg: [0, 0, " +
+             std::to_string(yaw_deg) + "], friction: 0.7,\n"
+             "     polygon: [[-0.12, -0.08], [0.12, -0.08], [0.12, 0.08], [-0.12, 0.08]]}\n";
+    std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
+    const std::string open_floor = test::sourcePath("models/scenes/open_floor.yaml");
+    text.replace(text.find(open_floor), open_floor.size(), dir.write("pad_scene.yaml", scene));
+    return Scenario::load(dir.write("pad.yaml", text));
+  };
+  for (const double yaw : {180.0, 0.0}) {
+    SCOPED_TRACE("pad frame turned " + std::to_string(yaw) + " degrees");
+    const Scenario sc = padFacing(yaw);
+    PostureRequest r;
+    for (const auto& c : sc.start_stance)
+      if (sc.robot->spots()[c.spot].name == "l_sole") r.contacts.push_back(c);
+    ASSERT_EQ(r.contacts.size(), 1u);
+    r.initial_guess = sc.start;
+    FloatingContact f;
+    f.spot = sc.robot->spotIndex("r_sole");
+    f.surface = sc.scene->surfaceIndex("pad");
+    f.volume.polygon = sc.scene->surfaces()[f.surface].polygon;  // anywhere on the pad, any angle
+    r.floating = f;
+    PostureGenerator pg(sc.robot, sc.scene);
+    const PostureResult res = pg.solve(r);
+    ASSERT_TRUE(res.success()) << toString(res.status) << ": " << res.reason;
+    EXPECT_EQ(res.footprint_turned, yaw == 180.0);
+    EXPECT_EQ(res.solves, yaw == 180.0 ? 2 : 1);
+    EXPECT_FALSE(res.retried);
+    // The solver's angle and the sole's: half a turn apart on the turned pad.
+    Kinematics k(sc.robot);
+    k.setConfiguration(res.configuration);
+    const double sole = projectOnSurface(sc.scene->surfaces()[f.surface], k.spotPose(f.spot)).theta;
+    EXPECT_NEAR(std::abs(std::remainder(sole - res.floating.theta, 2 * M_PI)), yaw == 180.0 ? M_PI : 0.0, 0.2);
+    std::vector<ContactSpec> stance = r.contacts;
+    stance.push_back(placedContact(r, res));
+    expectValid(sc, res, stance);  // the sole's corners on the pad among the rest
+  }
 }
 
 TEST(PostureGenerator, ContactOutOfReachIsInfeasibleWithinItsTimeLimit) {  // (d)

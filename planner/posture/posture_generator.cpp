@@ -239,17 +239,67 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
 PostureGenerator::~PostureGenerator() = default;
 
 PostureResult PostureGenerator::solve(const PostureRequest& request, const std::atomic<bool>* stop) {
-  PostureResult res = solveOnce(request, stop);
+  PostureResult res = solveHeld(request, stop);
   if (res.success() || res.status == PostureResult::Status::BadInput ||
       res.status == PostureResult::Status::Stopped || !request.retry_guess)
     return res;
   PostureRequest again = request;
   again.initial_guess = *request.retry_guess;
   again.retry_guess.reset();
-  PostureResult second = solveOnce(again, stop);
-  second.solves = 2;
+  PostureResult second = solveHeld(again, stop);
+  second.solves += res.solves;
+  second.retried = true;
   second.iterations += res.iterations;
   second.seconds += res.seconds;
+  return second;
+}
+
+// Beyond the validity contract's tolerance on spot polygon corners (docs/design.md section 9).
+constexpr double kFootprintTolerance = 1e-3;
+
+bool PostureGenerator::footprintOffTheSurface(const PostureRequest& request, const PostureResult& res,
+                                              bool half_turn_only) const {
+  if (!request.floating || !res.success()) return false;
+  const FloatingContact& f = *request.floating;
+  const Surface& s = scene_->surfaces()[f.surface];
+  Kinematics kin(robot_);
+  kin.setConfiguration(res.configuration);
+  const Eigen::Isometry3d spot = kin.spotPose(f.spot);
+  if (half_turn_only && spot.linear().col(0).dot(contactFrame(s, res.floating).linear().col(0)) >= 0) return false;
+  const Eigen::Isometry3d in_surface = s.frame.inverse() * spot;
+  for (const auto& v : robot_->spots()[f.spot].polygon.vertices())
+    if (s.polygon.signedDistance((in_surface * Eigen::Vector3d(v.x(), v.y(), 0)).head<2>()) > kFootprintTolerance)
+      return true;
+  return false;
+}
+
+// The contact rows fix the floating spot's angle only modulo pi, and the
+// footprint rows hold its polygon at the solver's angle: a solve that ends
+// with the spot half a turn from that angle (a sole on a surface whose frame
+// faces the other way) has held the sole turned about its origin, which for
+// a polygon that is not its own half turn is another footprint (HRP-2's
+// sole: 6.3 cm along the foot). When the spot's own footprint is then off
+// the surface (beyond the contract's tolerance: what the independent check
+// would refuse), the request is solved again with the footprint rows turned
+// (FloatingContact::footprint_turned), from the same guess: the solve ends
+// on the same branch, its footprint now the spot's. Solves whose footprint
+// the check accepts are kept as they are: their witnesses, and every search
+// built on them, are what they were.
+PostureResult PostureGenerator::solveHeld(const PostureRequest& request, const std::atomic<bool>* stop) {
+  PostureResult res = solveOnce(request, stop);
+  if (!request.floating || request.floating->footprint_turned || !footprintOffTheSurface(request, res, true))
+    return res;
+  PostureRequest turned = request;
+  turned.floating->footprint_turned = true;
+  PostureResult second = solveOnce(turned, stop);
+  second.solves += res.solves;
+  second.footprint_turned = true;
+  second.iterations += res.iterations;
+  second.seconds += res.seconds;
+  if (footprintOffTheSurface(turned, second, false)) {  // ended on the other branch: neither footprint held
+    second.status = PostureResult::Status::Infeasible;
+    second.reason = "the floating spot's footprint leaves its surface with its polygon held either way";
+  }
   return second;
 }
 

@@ -77,7 +77,12 @@ struct PostureResult {
   std::vector<PostureProblem::ContactForces> forces;  // per supporting contact
   double cost = 0;
   int iterations = 0;
-  int solves = 1;                     // 2 when the request's retry_guess was solved too
+  int solves = 1;                     // problems solved: more than 1 when retried or turned (below)
+  bool retried = false;               // the request's retry_guess was solved too (its first guess failed)
+  // Solved again with the floating spot's footprint turned half a turn
+  // (FloatingContact::footprint_turned): the first solve ended with the spot
+  // half a turn from the solver's angle and its own footprint off the surface.
+  bool footprint_turned = false;
   double seconds = 0;                 // wall time
   bool success() const { return status == Status::Success; }
 };
@@ -111,6 +116,12 @@ class PostureGenerator {
  private:
   struct Ipopt;
   PostureResult solveOnce(const PostureRequest& request, const std::atomic<bool>* stop);
+  // solveOnce, then again with the floating footprint turned if needed.
+  PostureResult solveHeld(const PostureRequest& request, const std::atomic<bool>* stop);
+  // Whether a success's floating spot has a corner off its surface (beyond
+  // the contract's tolerance); `half_turn_only`: and the spot is half a turn
+  // from the solver's angle (its x axis against the target frame's).
+  bool footprintOffTheSurface(const PostureRequest& request, const PostureResult& res, bool half_turn_only) const;
   std::shared_ptr<const RobotModel> robot_;
   std::shared_ptr<const Scene> scene_;
   std::shared_ptr<const CollisionModel> collision_;

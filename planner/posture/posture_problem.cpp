@@ -134,6 +134,9 @@ PostureProblem::PostureProblem(std::shared_ptr<const RobotModel> robot, std::sha
 
   // Collision pairs near the initial guess, except a contacting body on its surface's obstacle.
   kin_.setConfiguration(req_.initial_guess);
+  if (req_.floating)
+    for (const auto& v : robot_->spots()[req_.floating->spot].polygon.vertices())
+      floating_footprint_.push_back(req_.floating->footprint_turned ? Eigen::Vector2d(-v) : v);
   std::vector<int> near = collision_->pairsWithin(kin_, opt_.collision_cutoff);
   addCollisionPairs(near);
 }
@@ -411,7 +414,7 @@ Eigen::MatrixXd PostureProblem::lagrangianHessian(const Eigen::VectorXd& x, doub
     halfPlanes(scene_->surfaces()[f.surface].polygon, n, b);
     const Eigen::Matrix2d R = Eigen::Rotation2Dd(x[x_float_ + 2]).toRotationMatrix();
     int r = row_floating_ + static_cast<int>(f.volume.polygon.size());
-    for (const auto& c : m.spots()[f.spot].polygon.vertices())
+    for (const auto& c : floating_footprint_)
       for (const auto& ne : n) H(x_float_ + 2, x_float_ + 2) += -y[r++] * ne.dot(R * c);
   }
 
@@ -629,7 +632,7 @@ void PostureProblem::evaluate(const Eigen::VectorXd& x) {
     const Eigen::Matrix2d R = Eigen::Rotation2Dd(th).toRotationMatrix();
     Eigen::Matrix2d dR;
     dR << -std::sin(th), -std::cos(th), std::cos(th), -std::sin(th);
-    for (const auto& c : m.spots()[f.spot].polygon.vertices())
+    for (const auto& c : floating_footprint_)
       for (const auto& ne : n) {
         g_[r] = ne.dot(p + R * c);
         jac_(r, x_float_) = ne.x();

@@ -46,6 +46,12 @@ struct FloatingContact {
   int spot = -1;
   int surface = -1;
   SearchVolume volume;
+  // The contact rows fix the spot's angle only modulo pi: a solve can end
+  // with the spot half a turn from the solver's angle. The footprint rows
+  // hold the spot's polygon at the solver's angle, or, with this set, half
+  // a turn from it (PostureGenerator::solve sets it to solve again when a
+  // solve ends so with the spot's own footprint off the surface).
+  bool footprint_turned = false;
 };
 
 // A spot's frame held at a world pose, with no surface (the interpolator's
@@ -213,6 +219,9 @@ class PostureProblem {
   std::vector<int> pairs_;
   std::vector<std::pair<int, int>> allowed_touch_;  // (link, obstacle)
   std::vector<std::pair<int, int>> near_touch_;     // (link, obstacle): the pose target's, at touch_margin
+  // The floating spot's polygon as its footprint rows hold it in the frame
+  // of the solver's angle (FloatingContact::footprint_turned).
+  std::vector<Eigen::Vector2d> floating_footprint_;
 
   int nq_ = 0, nx_ = 0, ng_ = 0;
   int x_float_ = -1, x_lambda_ = -1, n_lambda_ = 0;

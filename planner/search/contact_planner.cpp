@@ -414,7 +414,7 @@ struct ContactPlanner::Impl {
         stats.posture_calls += b.results[i].solves;  // a retry is a call
         pending_calls += b.results[i].solves;
         if (!b.results[i].success()) ++stats.posture_failures;
-        if (b.results[i].solves > 1) ++stats.limb_retries, stats.limb_retry_successes += b.results[i].success();
+        if (b.results[i].retried) ++stats.limb_retries, stats.limb_retry_successes += b.results[i].success();
       }
     return b;
   }
@@ -430,14 +430,15 @@ struct ContactPlanner::Impl {
     if (!b.ran[i]) return;
     pending_calls -= b.results[i].solves;
     stats.posture_calls -= b.results[i].solves;
-    if (b.results[i].solves > 1) --stats.limb_retries, stats.limb_retry_successes -= b.results[i].success();
+    if (b.results[i].retried) --stats.limb_retries, stats.limb_retry_successes -= b.results[i].success();
     if (!b.results[i].success()) --stats.posture_failures;
     ++stats.calls_ahead_unused;
   }
 
   void traceCall(const std::string& what, const PostureResult& res) const {
     if (p.trace)
-      p.trace("  " + what + ": " + toString(res.status) + (res.solves > 1 ? " with the guide's limb" : "") + " (" +
+      p.trace("  " + what + ": " + toString(res.status) + (res.retried ? " with the guide's limb" : "") +
+              (res.footprint_turned ? " with its footprint turned" : "") + " (" +
               std::to_string(res.iterations) + " it, " + std::to_string(res.seconds * 1e3).substr(0, 5) + " ms)");
   }
 
