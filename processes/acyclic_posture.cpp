@@ -131,8 +131,10 @@ int main(int argc, char** argv) {
     o.problem.friction_share = friction_share;
     PostureGenerator pg(sc.robot, sc.scene, o);
     const PostureResult res = pg.solve(r);
-    std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s\n", toString(res.status), res.iterations,
-                res.seconds * 1e3, res.reason.empty() ? "" : ": ", res.reason.c_str());
+    std::printf("acyclic-posture: %s in %d iterations, %.1f ms%s%s%s\n", toString(res.status), res.iterations,
+                res.seconds * 1e3,
+                res.footprint_turned ? ", solved again with the added spot's footprint turned half a turn" : "",
+                res.reason.empty() ? "" : ": ", res.reason.c_str());
     Kinematics kin(sc.robot);
     kin.setConfiguration(res.configuration);
     const Eigen::Vector3d com = kin.centerOfMass();
@@ -146,6 +148,10 @@ int main(int argc, char** argv) {
       c.surface = r.floating->surface;
       c.supporting = false;
       c.placement = res.floating;
+      // The contact rows fix the angle only modulo pi: the placement takes
+      // the witness's own angle, as the planner's nodes do, so that the
+      // contact frame written is the spot's.
+      c.placement.theta = projectOnSurface(sc.scene->surfaces()[c.surface], kin.spotPose(c.spot)).theta;
       stance.push_back(c);
       std::printf("  added %s at (%.3f, %.3f, %.3f)\n", sc.describe(c).c_str(), c.placement.x, c.placement.y,
                   c.placement.theta);

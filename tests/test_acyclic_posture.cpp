@@ -3,6 +3,7 @@
 // independent check (the exit status says so) and it names bad input.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "planner/plan/plan.h"
@@ -138,6 +139,41 @@ TEST(AcyclicPosture, StanceReposesAPlansStanceAsThePlanHoldsIt) {
   bad = probe("--stance 0");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.output.find("--from"), std::string::npos) << bad.output;
+}
+
+TEST(AcyclicPosture, ASoleOnAPadFacingTheOtherWayIsWrittenAtItsOwnAngle) {
+  // Standing on the left foot, the right sole added on a pad whose frame
+  // faces against the robot: the solver's angle is half a turn from the
+  // sole's (the contact rows fix it modulo pi), so the generator solves it
+  // again with the footprint turned (it says so), and the contact written
+  // takes the sole's own angle, about pi in the pad's frame, as the
+  // planner's nodes do: its frame is the spot's.
+  acyclic::test::TempDir dir;
+  std::string scene = acyclic::test::readFile(acyclic::test::sourcePath("models/scenes/open_floor.yaml"));
+  scene += "  - {name: pad, obstacle: floor, position: [0.22, -0.095, 0], rpy_deg: [0, 0, 180], friction: 0.7,\n"
+           "     polygon: [[-0.12, -0.08], [0.12, -0.08], [0.12, 0.08], [-0.12, 0.08]]}\n";
+  std::string text = acyclic::test::scenarioText("models/scenarios/step_forward.yaml");
+  const std::string open_floor = acyclic::test::sourcePath("models/scenes/open_floor.yaml");
+  text.replace(text.find(open_floor), open_floor.size(), dir.write("pad_scene.yaml", scene));
+  const std::string right = "    - {spot: r_sole, surface: floor}\n";
+  ASSERT_NE(text.find(right), std::string::npos);
+  text.erase(text.find(right), right.size());  // the start on the left foot alone
+  const std::string scenario = dir.write("pad.yaml", text);
+  const auto r = acyclic::test::runProcess(acyclic::test::binaryPath("processes/acyclic-posture") + " " + scenario +
+                                           " --add r_sole@pad --out " + dir.path() + "/p.json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("solved again with the added spot's footprint turned half a turn"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("[ ok ] contacts"), std::string::npos) << r.output;
+  const acyclic::Scenario sc = acyclic::Scenario::load(scenario);
+  const acyclic::Plan plan = acyclic::readPlan(dir.path() + "/p.json", sc);
+  bool found = false;
+  for (const auto& c : plan.stances.back().contacts)
+    if (sc.robot->spots()[c.spec.spot].name == "r_sole") {
+      found = true;
+      EXPECT_NEAR(std::abs(c.spec.placement.theta), M_PI, 0.2);
+    }
+  EXPECT_TRUE(found);
 }
 
 TEST(AcyclicPosture, BadInputIsNamedAndExitsTwo) {
