@@ -149,16 +149,7 @@ TEST(AcyclicPosture, ASoleOnAPadFacingTheOtherWayIsWrittenAtItsOwnAngle) {
   // takes the sole's own angle, about pi in the pad's frame, as the
   // planner's nodes do: its frame is the spot's.
   acyclic::test::TempDir dir;
-  std::string scene = acyclic::test::readFile(acyclic::test::sourcePath("models/scenes/open_floor.yaml"));
-  scene += "  - {name: pad, obstacle: floor, position: [0.22, -0.095, 0], rpy_deg: [0, 0, 180], friction: 0.7,\n"
-           "     polygon: [[-0.12, -0.08], [0.12, -0.08], [0.12, 0.08], [-0.12, 0.08]]}\n";
-  std::string text = acyclic::test::scenarioText("models/scenarios/step_forward.yaml");
-  const std::string open_floor = acyclic::test::sourcePath("models/scenes/open_floor.yaml");
-  text.replace(text.find(open_floor), open_floor.size(), dir.write("pad_scene.yaml", scene));
-  const std::string right = "    - {spot: r_sole, surface: floor}\n";
-  ASSERT_NE(text.find(right), std::string::npos);
-  text.erase(text.find(right), right.size());  // the start on the left foot alone
-  const std::string scenario = dir.write("pad.yaml", text);
+  const std::string scenario = acyclic::test::padScenario(dir, 180, false);  // the start on the left foot alone
   const auto r = acyclic::test::runProcess(acyclic::test::binaryPath("processes/acyclic-posture") + " " + scenario +
                                            " --add r_sole@pad --out " + dir.path() + "/p.json");
   ASSERT_EQ(r.status, 0) << r.output;

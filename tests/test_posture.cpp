@@ -584,20 +584,10 @@ TEST(PostureGenerator, AFloatingSoleKeepsItsOwnFootprintOnASurfaceFacingTheOther
   // edge and the independent check refused the posture. The generator now
   // solves such a request again with the footprint turned: valid. On the
   // same pad facing the robot's way one solve is enough.
-  auto padFacing = [](double yaw_deg) {
-    test::TempDir dir;
-    std::string scene = test::readFile(test::sourcePath("models/scenes/open_floor.yaml"));
-    scene += "  - {name: pad, obstacle: floor, position: [0.22, -0.095, 0], rpy_deg: [0, 0, " +
-             std::to_string(yaw_deg) + "], friction: 0.7,\n"
-             "     polygon: [[-0.12, -0.08], [0.12, -0.08], [0.12, 0.08], [-0.12, 0.08]]}\n";
-    std::string text = test::scenarioText("models/scenarios/step_forward.yaml");
-    const std::string open_floor = test::sourcePath("models/scenes/open_floor.yaml");
-    text.replace(text.find(open_floor), open_floor.size(), dir.write("pad_scene.yaml", scene));
-    return Scenario::load(dir.write("pad.yaml", text));
-  };
   for (const double yaw : {180.0, 0.0}) {
     SCOPED_TRACE("pad frame turned " + std::to_string(yaw) + " degrees");
-    const Scenario sc = padFacing(yaw);
+    test::TempDir dir;
+    const Scenario sc = Scenario::load(test::padScenario(dir, yaw));
     PostureRequest r;
     for (const auto& c : sc.start_stance)
       if (sc.robot->spots()[c.spot].name == "l_sole") r.contacts.push_back(c);

@@ -73,6 +73,24 @@ inline std::string scenarioText(const std::string& rel) {
   return text;
 }
 
+// step_forward's scenario, written to `dir`, on an open floor with a pad
+// 0.24 m by 0.16 m in front of the right foot whose frame is turned by
+// `yaw_deg` about the vertical (180: facing against the robot); without
+// `right_sole_in_start`, the start stands on the left foot alone. Returns
+// the scenario file's path.
+inline std::string padScenario(const TempDir& dir, double yaw_deg, bool right_sole_in_start = true) {
+  std::string scene = readFile(sourcePath("models/scenes/open_floor.yaml"));
+  scene += "  - {name: pad, obstacle: floor, position: [0.22, -0.095, 0], rpy_deg: [0, 0, " + std::to_string(yaw_deg) +
+           "], friction: 0.7,\n"
+           "     polygon: [[-0.12, -0.08], [0.12, -0.08], [0.12, 0.08], [-0.12, 0.08]]}\n";
+  std::string text = scenarioText("models/scenarios/step_forward.yaml");
+  const std::string open_floor = sourcePath("models/scenes/open_floor.yaml");
+  text.replace(text.find(open_floor), open_floor.size(), dir.write("pad_scene.yaml", scene));
+  const std::string right = "    - {spot: r_sole, surface: floor}\n";
+  if (!right_sole_in_start) text.erase(text.find(right), right.size());
+  return dir.write("pad.yaml", text);
+}
+
 // Replaces `from` by `to` in a file's text and expects `parse(text)` to throw
 // a FormatError naming `file` and `field`.
 template <class Parse>
