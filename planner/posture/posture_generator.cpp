@@ -254,9 +254,6 @@ PostureResult PostureGenerator::solve(const PostureRequest& request, const std::
   return second;
 }
 
-// Beyond the validity contract's tolerance on spot polygon corners (docs/design.md section 9).
-constexpr double kFootprintTolerance = 1e-3;
-
 bool PostureGenerator::footprintOffTheSurface(const PostureRequest& request, const PostureResult& res,
                                               bool half_turn_only) const {
   if (!request.floating || !res.success()) return false;
@@ -268,7 +265,7 @@ bool PostureGenerator::footprintOffTheSurface(const PostureRequest& request, con
   if (half_turn_only && spot.linear().col(0).dot(contactFrame(s, res.floating).linear().col(0)) >= 0) return false;
   const Eigen::Isometry3d in_surface = s.frame.inverse() * spot;
   for (const auto& v : robot_->spots()[f.spot].polygon.vertices())
-    if (s.polygon.signedDistance((in_surface * Eigen::Vector3d(v.x(), v.y(), 0)).head<2>()) > kFootprintTolerance)
+    if (s.polygon.signedDistance((in_surface * Eigen::Vector3d(v.x(), v.y(), 0)).head<2>()) > kContactPolygonTolerance)
       return true;
   return false;
 }

@@ -16,7 +16,6 @@ constexpr double kInf = 1e19;  // Ipopt's infinity
 // that the same placement, later a fixed contact, passes the check below
 // (the contract allows 1 mm; the solver meets its bounds only to tolerance).
 constexpr double kFloatingPolygonMargin = 1e-4;
-constexpr double kContactPolygonTolerance = 1e-3;
 const Eigen::Vector3d kGravity(0, 0, -9.81);
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {

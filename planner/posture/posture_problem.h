@@ -34,6 +34,12 @@
 
 namespace acyclic {
 
+// How far a spot polygon's corner may lie outside its surface polygon (the
+// validity contract's 1 mm, docs/design.md section 9): a fixed contact's
+// placement is refused beyond it, and a floating contact's footprint solved
+// again (PostureGenerator::solve).
+constexpr double kContactPolygonTolerance = 1e-3;
+
 // The floating contact's search volume C_i: (x, y) in a convex polygon of the
 // surface frame, theta in [theta_min, theta_max].
 struct SearchVolume {
