@@ -107,16 +107,32 @@ PostureOptions withMargins() {
   return o;
 }
 
+// The problems whose derivatives are checked: the left wrist floating on the
+// table, with and without stability margins, its footprint rows as they are
+// and held half a turn round (FloatingContact::footprint_turned).
+struct DerivativeCase {
+  std::string name;
+  PostureOptions options;
+  PostureRequest request;
+};
+std::vector<DerivativeCase> derivativeCases(const Scenario& sc) {
+  std::vector<DerivativeCase> cases;
+  for (const bool margins : {false, true})
+    for (const bool turned : {false, true}) {
+      DerivativeCase c{std::string(margins ? "with margins" : "without margins") + (turned ? ", footprint turned" : ""),
+                       margins ? withMargins() : PostureOptions{}, wristOnTable(sc)};
+      c.request.floating->footprint_turned = turned;
+      cases.push_back(std::move(c));
+    }
+  return cases;
+}
+
 TEST(PostureProblem, DerivativesMatchFiniteDifferences) {
   const Scenario& sc = chair();
   auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
-  for (const PostureOptions& options : {PostureOptions{}, withMargins()})
-  for (const bool turned : {false, true}) {  // the floating footprint's rows held half a turn round
-  SCOPED_TRACE(std::string(options.support_inset > 0 ? "with margins" : "without margins") +
-               (turned ? ", footprint turned" : ""));
-  PostureRequest request = wristOnTable(sc);
-  request.floating->footprint_turned = turned;
-  PostureProblem p(sc.robot, sc.scene, cm, request, options);
+  for (const DerivativeCase& dc : derivativeCases(sc)) {
+  SCOPED_TRACE(dc.name);
+  PostureProblem p(sc.robot, sc.scene, cm, dc.request, dc.options);
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0, 0.05);
   for (int trial = 0; trial < 2; ++trial) {
@@ -196,13 +212,9 @@ TEST(PostureProblem, LagrangianHessianMatchesFiniteDifferences) {
   // terms, checked loosely) against differences of the constraint Jacobian.
   const Scenario& sc = chair();
   auto cm = std::make_shared<CollisionModel>(sc.robot, sc.scene);
-  for (const PostureOptions& options : {PostureOptions{}, withMargins()})
-  for (const bool turned : {false, true}) {  // the floating footprint's rows held half a turn round
-  SCOPED_TRACE(std::string(options.support_inset > 0 ? "with margins" : "without margins") +
-               (turned ? ", footprint turned" : ""));
-  PostureRequest request = wristOnTable(sc);
-  request.floating->footprint_turned = turned;
-  PostureProblem p(sc.robot, sc.scene, cm, request, options);
+  for (const DerivativeCase& dc : derivativeCases(sc)) {
+  SCOPED_TRACE(dc.name);
+  PostureProblem p(sc.robot, sc.scene, cm, dc.request, dc.options);
   std::mt19937 rng(2);
   std::normal_distribution<double> n(0, 0.05);
   Eigen::VectorXd x = p.initialPoint();
