@@ -230,6 +230,11 @@ InterpolationResult interpolateWith(const Plan& plan, const Scenario& sc, const 
         const std::string key = memo && cached == fr.solved.end() ? transitionKey(plan, d) : std::string();
         std::optional<TransitionOutcome> remembered;
         if (!key.empty()) remembered = memo->find(key);
+        std::string refused;  // why a remembered outcome from elsewhere is not used
+        if (remembered && memo->checksOnUse()) {
+          refused = s.check(plan, d, *remembered);
+          if (!refused.empty()) remembered.reset();
+        }
         TransitionOutcome o = cached != fr.solved.end() ? cached->second
                               : remembered                ? std::move(*remembered)
                                                           : s.solve(plan, d, cancel);
@@ -244,6 +249,8 @@ InterpolationResult interpolateWith(const Plan& plan, const Scenario& sc, const 
         std::lock_guard<std::mutex> lock(m);
         if (counted) tr.stats.posture_calls += o.posture_calls, res.posture_seconds += o.posture_seconds;
         if (remembered) ++res.reused;
+        if (!refused.empty() && res.refused++ == 0)
+          res.refused_reason = "stances " + std::to_string(d.from) + " -> " + std::to_string(d.to) + ": " + refused;
         outcomes[i] = std::move(o);
         done[i] = 1;
         pr.transition = static_cast<int>(++finished);

@@ -107,6 +107,10 @@ struct InterpolationResult {
   // Of those, taken from a memo (transition_memo.h) instead of solved: their
   // posture calls are not in the trajectory's stats, which count this run's.
   int reused = 0;
+  // Outcomes in a memo from elsewhere (TransitionMemo's check_on_use) that
+  // failed their check and were solved instead; why the first one failed.
+  int refused = 0;
+  std::string refused_reason;
   bool success() const { return status == Status::Success; }
 };
 

@@ -168,6 +168,15 @@ class TransitionSolver {
  public:
   TransitionSolver(const Scenario& sc, TransitionOptions options);
   TransitionOutcome solve(const Plan& plan, const TransitionDesign& d, const std::atomic<bool>* cancel = nullptr);
+  // Why an outcome solved elsewhere (another process's, TransitionMemo's
+  // check_on_use) cannot stand for transition `d` of `plan` under these
+  // options; empty when it can. It must be a success whose pieces join the
+  // first stance's witness to the last one's, each piece starting where the
+  // previous ended, hold only contacts of the transition's stances (spot,
+  // surface and placement), and every sample the time law makes of each
+  // piece must pass the validity check with the piece's contacts, as the
+  // samples of a transition solved here do.
+  std::string check(const Plan& plan, const TransitionDesign& d, const TransitionOutcome& o);
   const TransitionOptions& options() const { return opt_; }
 
  private:

@@ -10,6 +10,7 @@
 #include <algorithm>
 
 #include <atomic>
+#include <cmath>
 #include <functional>
 #include <utility>
 
@@ -1352,6 +1353,31 @@ TEST(PlanVerifier, RefusesWhatTheInterpolatorCannotDoAndRemembersWhatItSolved) {
   EXPECT_FALSE(stopped.ok());
 }
 
+namespace {
+// The same samples and phases, bit for bit.
+void expectSameTrajectory(const Trajectory& a, const Trajectory& b) {
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  ASSERT_EQ(a.phases.size(), b.phases.size());
+  for (std::size_t i = 0; i < a.samples.size(); ++i) {
+    ASSERT_EQ(a.samples[i].q.joints, b.samples[i].q.joints) << i;
+    ASSERT_EQ(a.samples[i].q.base_position, b.samples[i].q.base_position) << i;
+    ASSERT_EQ(a.samples[i].q.base_orientation.coeffs(), b.samples[i].q.base_orientation.coeffs()) << i;
+    ASSERT_EQ(a.samples[i].dq, b.samples[i].dq) << i;
+  }
+  for (std::size_t k = 0; k < a.phases.size(); ++k) {
+    EXPECT_EQ(a.phases[k].t_start, b.phases[k].t_start) << k;
+    ASSERT_EQ(a.phases[k].contacts.size(), b.phases[k].contacts.size()) << k;
+    for (std::size_t c = 0; c < a.phases[k].contacts.size(); ++c) {
+      const ContactSpec &x = a.phases[k].contacts[c], &y = b.phases[k].contacts[c];
+      EXPECT_TRUE(x.spot == y.spot && x.surface == y.surface && x.supporting == y.supporting &&
+                  x.placement.x == y.placement.x && x.placement.y == y.placement.y &&
+                  x.placement.theta == y.placement.theta)
+          << "phase " << k << ", contact " << c;
+    }
+  }
+}
+}  // namespace
+
 // A memo shared by the verifier and the interpolator (transition_memo.h):
 // what the verifier solved is taken from it, none solved again, and the
 // trajectory is the one interpolating from scratch gives, bit for bit. An
@@ -1367,17 +1393,7 @@ TEST(TransitionMemo, AVerifiedPlanIsInterpolatedWithoutSolvingItsTransitionsAgai
   ASSERT_TRUE(fresh.success()) << fresh.reason;
   ASSERT_GT(fresh.trajectory.stats.posture_calls, 0);
   EXPECT_EQ(fresh.reused, 0);
-  auto same = [&](const InterpolationResult& r) {
-    ASSERT_EQ(r.trajectory.samples.size(), fresh.trajectory.samples.size());
-    ASSERT_EQ(r.trajectory.phases.size(), fresh.trajectory.phases.size());
-    for (std::size_t i = 0; i < r.trajectory.samples.size(); ++i) {
-      ASSERT_EQ(r.trajectory.samples[i].q.joints, fresh.trajectory.samples[i].q.joints) << i;
-      ASSERT_EQ(r.trajectory.samples[i].q.base_position, fresh.trajectory.samples[i].q.base_position) << i;
-      ASSERT_EQ(r.trajectory.samples[i].q.base_orientation.coeffs(),
-                fresh.trajectory.samples[i].q.base_orientation.coeffs()) << i;
-      ASSERT_EQ(r.trajectory.samples[i].dq, fresh.trajectory.samples[i].dq) << i;
-    }
-  };
+  auto same = [&](const InterpolationResult& r) { expectSameTrajectory(r.trajectory, fresh.trajectory); };
 
   auto memo = std::make_shared<TransitionMemo>(opt);
   TransitionVerifier verifier(sc, memo);
@@ -1407,6 +1423,116 @@ TEST(TransitionMemo, AVerifiedPlanIsInterpolatedWithoutSolvingItsTransitionsAgai
   // A verifier's own memo keeps verdicts, not motion.
   TransitionMemo lean(opt, false);
   EXPECT_THROW(interpolate(plan, sc, lean), std::invalid_argument);
+}
+
+// Transitions solved elsewhere (the planner's, sent on ACYCLIC_TRANSITIONS)
+// in a memo that checks them before use: taken when they stand, the
+// trajectory the same as solving them here; one whose knots leave its
+// witness or its surface is refused with the reason and solved here, to the
+// same trajectory.
+TEST(TransitionMemo, TransitionsFromElsewhereAreCheckedAndABadOneIsSolvedHereInstead) {
+  const Scenario& sc = floorScenario();
+  InterpolatorOptions opt;
+  opt.steps = 8;
+  const Plan plan = planFromJson(planToJson(stepPlan(sc, 0.15), sc), "round trip", sc);
+  const InterpolationResult fresh = interpolate(plan, sc, opt);
+  ASSERT_TRUE(fresh.success()) << fresh.reason;
+
+  TransitionMemo solved(opt);
+  ASSERT_TRUE(interpolate(plan, sc, solved).success());
+  const std::vector<RememberedTransition> sent = rememberedTransitions(plan, solved);
+  ASSERT_EQ(static_cast<int>(sent.size()), fresh.trajectory.stats.transitions);
+  ASSERT_GE(sent.size(), 2u);
+
+  auto receive = [&](const std::vector<RememberedTransition>& ts) {
+    auto memo = std::make_shared<TransitionMemo>(opt, true, /*check_on_use=*/true);
+    for (const RememberedTransition& t : ts) memo->store(transitionKey(plan, t.design), t.outcome);
+    return memo;
+  };
+  const InterpolationResult taken = interpolate(plan, sc, *receive(sent));
+  ASSERT_TRUE(taken.success()) << taken.reason;
+  EXPECT_EQ(taken.reused, taken.trajectory.stats.transitions);
+  EXPECT_EQ(taken.refused, 0) << taken.refused_reason;
+  EXPECT_EQ(taken.trajectory.stats.posture_calls, 0);
+  expectSameTrajectory(taken.trajectory, fresh.trajectory);
+
+  // The first transition starts off its witness; the last one that moves
+  // has its middle knot lifted 5 cm, its soles off the floor.
+  std::vector<RememberedTransition> bad = sent;
+  ASSERT_EQ(bad.front().design.from, 0);
+  ASSERT_FALSE(bad.front().outcome.pieces.empty());
+  bad.front().outcome.pieces.front().knots.front().joints[0] += 0.01;
+  auto last = std::find_if(bad.rbegin(), bad.rend(), [](const auto& t) { return !t.outcome.pieces.empty(); });
+  ASSERT_TRUE(last != bad.rend() && last != std::prev(bad.rend()));
+  auto& pieces = last->outcome.pieces;
+  MotionPiece& piece = *std::max_element(pieces.begin(), pieces.end(), [](const auto& a, const auto& b) {
+    return a.knots.size() < b.knots.size();
+  });
+  ASSERT_GE(piece.knots.size(), 3u);
+  piece.knots[piece.knots.size() / 2].base_position.z() += 0.05;
+  const InterpolationResult mended = interpolate(plan, sc, *receive(bad));
+  ASSERT_TRUE(mended.success()) << mended.reason;
+  EXPECT_EQ(mended.refused, 2);
+  EXPECT_EQ(mended.reused, mended.trajectory.stats.transitions - 2);
+  EXPECT_NE(mended.refused_reason.find("does not start at stance 0's witness"), std::string::npos)
+      << mended.refused_reason;
+  EXPECT_GT(mended.trajectory.stats.posture_calls, 0);
+  expectSameTrajectory(mended.trajectory, fresh.trajectory);
+
+  // A memo of this process's own (no check on use) takes them as they are.
+  auto trusting = std::make_shared<TransitionMemo>(opt);
+  for (const RememberedTransition& t : bad) trusting->store(transitionKey(plan, t.design), t.outcome);
+  const InterpolationResult unchecked = interpolate(plan, sc, *trusting);
+  EXPECT_EQ(unchecked.refused, 0);
+  EXPECT_EQ(unchecked.reused, unchecked.trajectory.stats.transitions);
+}
+
+// The options' text (what decides whether transitions solved elsewhere are
+// used) changes with every option that decides a transition's outcome, and
+// not with the thread count or the stance filter.
+TEST(TransitionMemo, TheOptionsTextChangesWithEveryOptionThatDecidesAnOutcome) {
+  const InterpolatorOptions base;
+  const std::string text = outcomeOptionsText(base);
+  std::vector<std::pair<const char*, std::function<void(InterpolatorOptions&)>>> changes = {
+      {"steps", [](auto& o) { o.steps += 1; }},
+      {"fixed_step", [](auto& o) { o.fixed_step = std::nextafter(o.fixed_step, 1.0); }},
+      {"dt", [](auto& o) { o.dt *= 2; }},
+      {"speed_cap", [](auto& o) { o.speed_cap *= 2; }},
+      {"velocity_share", [](auto& o) { o.velocity_share /= 2; }},
+      {"link_acceleration_cap", [](auto& o) { o.link_acceleration_cap *= 2; }},
+      {"zmp_shift_cap", [](auto& o) { o.zmp_shift_cap = 0.01; }},
+      {"lift", [](auto& o) { o.lift *= 2; }},
+      {"touch_clearance", [](auto& o) { o.touch_clearance *= 2; }},
+      {"air_orientation_tolerance", [](auto& o) { o.air_orientation_tolerance /= 2; }},
+      {"repair_attempts", [](auto& o) { o.repair_attempts += 1; }},
+      {"repair_step", [](auto& o) { o.repair_step *= 2; }},
+      {"plan_body_path", [](auto& o) { o.plan_body_path = !o.plan_body_path; }},
+      {"free_limb_paths", [](auto& o) { o.free_limb_paths = !o.free_limb_paths; }},
+      {"limb_joint_paths", [](auto& o) { o.limb_joint_paths = !o.limb_joint_paths; }},
+      {"wide_clearance", [](auto& o) { o.wide_clearance *= 2; }},
+      {"refine_depth", [](auto& o) { o.refine_depth += 1; }},
+      {"bridge_jumps", [](auto& o) { o.bridge_jumps = !o.bridge_jumps; }},
+      {"order_by_failure", [](auto& o) { o.order_by_failure = !o.order_by_failure; }},
+      {"verify_samples", [](auto& o) { o.verify_samples = !o.verify_samples; }},
+      {"pyramid_edges", [](auto& o) { o.pyramid_edges = 8; }},
+      {"support_inset", [](auto& o) { o.support_inset = 0.01; }},
+      {"support_inset_y", [](auto& o) { o.support_inset_y = 0.01; }},
+      {"friction_share", [](auto& o) { o.friction_share = 0.8; }},
+      {"posture_iterations", [](auto& o) { o.posture_iterations += 1; }},
+      {"collision_cutoff", [](auto& o) { o.collision_cutoff *= 2; }},
+      {"posture_ipopt_options", [](auto& o) { o.posture_ipopt_options.push_back("tol=1e-9"); }},
+      {"posture_lbfgs_in_kkt", [](auto& o) { o.posture_lbfgs_in_kkt = !o.posture_lbfgs_in_kkt; }},
+      {"posture_mu_oracle", [](auto& o) { o.posture_mu_oracle = "probing"; }},
+  };
+  for (const auto& [name, change] : changes) {
+    InterpolatorOptions o = base;
+    change(o);
+    EXPECT_NE(outcomeOptionsText(o), text) << name;
+  }
+  InterpolatorOptions o = base;
+  o.threads = 1;
+  o.filter = !o.filter;
+  EXPECT_EQ(outcomeOptionsText(o), text);
 }
 
 namespace {
