@@ -8,6 +8,9 @@ inline constexpr const char* kRequest = "ACYCLIC_REQUEST";          // request_t
 inline constexpr const char* kCancel = "ACYCLIC_CANCEL";            // cancel_t
 inline constexpr const char* kGuide = "ACYCLIC_GUIDE";              // guide_t
 inline constexpr const char* kPlan = "ACYCLIC_PLAN";                // plan_t
+// The transitions the planner's verification solved for a plan, sent just
+// before it: a cache for the interpolator, never needed.
+inline constexpr const char* kTransitions = "ACYCLIC_TRANSITIONS";  // transitions_t
 inline constexpr const char* kTrajectory = "ACYCLIC_TRAJECTORY";    // trajectory_t
 inline constexpr const char* kProgress = "ACYCLIC_PROGRESS";        // progress_t
 inline constexpr const char* kStatus = "ACYCLIC_STATUS";            // process_status_t

@@ -17,7 +17,9 @@ void checkJointNames(const std::vector<std::string>& names, const Scenario& sc, 
                                                  " joint names in controller order");
 }
 
-ContactSpec specFrom(const contact_t& c, const Scenario& sc, const std::string& origin, const std::string& at) {
+}  // namespace
+
+ContactSpec fromMessage(const contact_t& c, const Scenario& sc, const std::string& origin, const std::string& at) {
   ContactSpec s;
   s.spot = sc.robot->spotIndex(c.spot);
   if (s.spot < 0) throw FormatError(origin, at + ".spot", "a contact spot of the robot (got '" + c.spot + "')");
@@ -29,7 +31,7 @@ ContactSpec specFrom(const contact_t& c, const Scenario& sc, const std::string& 
   return s;
 }
 
-contact_t contactTo(const ContactSpec& s, const Scenario& sc) {
+contact_t toMessage(const ContactSpec& s, const Scenario& sc) {
   contact_t c{};
   c.spot = sc.robot->spots()[s.spot].name;
   c.surface = sc.scene->surfaces()[s.surface].name;
@@ -44,8 +46,6 @@ contact_t contactTo(const ContactSpec& s, const Scenario& sc) {
   c.num_points = 0;
   return c;
 }
-
-}  // namespace
 
 configuration_t toMessage(const Configuration& q) {
   configuration_t m{};
@@ -79,7 +79,7 @@ plan_t toMessage(const Plan& plan, const Scenario& sc) {
   for (const auto& s : plan.stances) {
     stance_t st{};
     for (const auto& c : s.contacts) {
-      contact_t mc = contactTo(c.spec, sc);
+      contact_t mc = toMessage(c.spec, sc);
       mc.num_points = static_cast<int32_t>(c.points.size());
       for (std::size_t k = 0; k < c.points.size(); ++k) {
         mc.points.push_back({c.points[k].x(), c.points[k].y(), c.points[k].z()});
@@ -112,7 +112,7 @@ Plan fromMessage(const plan_t& m, const Scenario& sc) {
     for (std::size_t k = 0; k < st.contacts.size(); ++k) {
       const contact_t& mc = st.contacts[k];
       PlanContact c;
-      c.spec = specFrom(mc, sc, origin, field(field("stances", i) + ".contacts", k));
+      c.spec = fromMessage(mc, sc, origin, field(field("stances", i) + ".contacts", k));
       c.frame = contactFrame(sc.scene->surfaces()[c.spec.surface], c.spec.placement);
       for (int p = 0; p < mc.num_points; ++p) {
         c.points.emplace_back(mc.points[p][0], mc.points[p][1], mc.points[p][2]);
@@ -193,7 +193,7 @@ Trajectory fromMessage(const trajectory_t& m, const Scenario& sc) {
       c.surface = mp.surfaces[k];
       c.supporting = mp.supporting[k];
       c.x = mp.x[k], c.y = mp.y[k], c.theta = mp.theta[k];
-      p.contacts.push_back(specFrom(c, sc, origin, field(field("phases", i) + ".contacts", k)));
+      p.contacts.push_back(fromMessage(c, sc, origin, field(field("phases", i) + ".contacts", k)));
     }
     tr.phases.push_back(p);
   }

@@ -6,6 +6,7 @@
 // messages (hrp2_command_t, hrp2_state_t, hrp2_bridge_status_t) to and from
 // the bridge's and the simulated controller's types.
 #include "acyclic/configuration_t.hpp"
+#include "acyclic/contact_t.hpp"
 #include "acyclic/hrp2_bridge_status_t.hpp"
 #include "acyclic/hrp2_command_t.hpp"
 #include "acyclic/hrp2_state_t.hpp"
@@ -20,6 +21,11 @@ namespace acyclic::convert {
 
 configuration_t toMessage(const Configuration& q);
 Configuration fromMessage(const configuration_t& m, const Scenario& sc, const std::string& origin);
+
+// A contact's spot, surface, support and placement (and its frame's world
+// pose; no points or forces). Read back, `at` names the field in `origin`.
+contact_t toMessage(const ContactSpec& s, const Scenario& sc);
+ContactSpec fromMessage(const contact_t& c, const Scenario& sc, const std::string& origin, const std::string& at);
 
 // The plan's stances and stats; header fields (utime, request_id, status,
 // scenario) are the caller's.

@@ -7,6 +7,9 @@
 #include "planner/common/format_error.h"
 #include "processes/lcm_convert.h"
 #include "processes/lcm_process.h"
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+#include "processes/transitions_message.h"
+#endif
 #include "test_support.h"
 
 using namespace acyclic;
@@ -218,3 +221,108 @@ TEST(LcmProcess, ABusyRefusalIsRecognisedForTheRequestItNamesOnly) {
   EXPECT_FALSE(acyclic::proc::isBusyWith(r, 1));
   EXPECT_FALSE(acyclic::proc::isBusyWith("no plan within 60 s", 12));
 }
+
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+// The planner's transitions (ACYCLIC_TRANSITIONS) through the wire and into
+// the interpolator's memo: the knots to the bit (their quaternions not
+// normalized again, so that the trajectory is the one solving gives), keyed
+// against the plan; a message with a bad field is refused by that field, and
+// nothing of it stored.
+TEST(LcmConvert, TransitionsRoundTripIntoAMemo) {
+  const Scenario& sc = chair();
+  Plan plan;
+  for (int k = 0; k < 2; ++k) {
+    PlanStance s;
+    s.configuration = sc.start;
+    s.configuration.joints[3] += 0.01 * k;
+    for (const auto& spec : sc.start_stance) {
+      PlanContact c;
+      c.spec = spec;
+      s.contacts.push_back(c);
+    }
+    plan.stances.push_back(s);
+  }
+  RememberedTransition t;
+  t.design.kind = TransitionDesign::Kind::Move;
+  t.design.from = 0;
+  t.design.to = 1;
+  t.outcome.ok = true;
+  t.outcome.repaired = true;
+  t.outcome.how = "raised 0.05 m";
+  t.outcome.attempts = 2;
+  t.outcome.refinements = 3;
+  t.outcome.posture_calls = 17;
+  for (int p = 0; p < 2; ++p) {
+    MotionPiece piece;
+    piece.stance = p;
+    piece.contacts = sc.start_stance;
+    for (int k = 0; k < 3; ++k) {
+      Configuration q = plan.stances[0].configuration;
+      q.joints[3] += 0.003 * k + 0.01 * p;
+      q.base_orientation.coeffs() *= 1 + 3e-14;  // a solver's quaternion, not quite unit
+      piece.knots.push_back(q);
+    }
+    t.outcome.pieces.push_back(piece);
+  }
+  InterpolatorOptions opt;
+  opt.steps = 7;
+  transitions_t m = wire(convert::toMessage({t}, opt, sc));
+  m.request_id = 5;
+  EXPECT_EQ(m.options, outcomeOptionsText(opt));
+  TransitionMemo memo(opt, true, true);
+  EXPECT_EQ(convert::fillMemo(m, plan, sc, memo), 1u);
+  const std::optional<TransitionOutcome> back = memo.find(transitionKey(plan, t.design));
+  ASSERT_TRUE(back.has_value());
+  EXPECT_TRUE(back->ok && back->repaired && !back->still);
+  EXPECT_EQ(back->how, t.outcome.how);
+  EXPECT_EQ(back->attempts, 2);
+  EXPECT_EQ(back->refinements, 3);
+  EXPECT_EQ(back->posture_calls, 17);
+  ASSERT_EQ(back->pieces.size(), 2u);
+  for (std::size_t p = 0; p < 2; ++p) {
+    const MotionPiece &a = back->pieces[p], &b = t.outcome.pieces[p];
+    EXPECT_EQ(a.stance, b.stance);
+    ASSERT_EQ(a.contacts.size(), b.contacts.size());
+    for (std::size_t c = 0; c < a.contacts.size(); ++c) {
+      EXPECT_EQ(a.contacts[c].spot, b.contacts[c].spot);
+      EXPECT_EQ(a.contacts[c].surface, b.contacts[c].surface);
+      EXPECT_EQ(a.contacts[c].supporting, b.contacts[c].supporting);
+      EXPECT_EQ(a.contacts[c].placement.theta, b.contacts[c].placement.theta);
+    }
+    ASSERT_EQ(a.knots.size(), b.knots.size());
+    for (std::size_t k = 0; k < a.knots.size(); ++k) {
+      EXPECT_EQ(a.knots[k].joints, b.knots[k].joints);
+      EXPECT_EQ(a.knots[k].base_position, b.knots[k].base_position);
+      EXPECT_EQ(a.knots[k].base_orientation.coeffs(), b.knots[k].base_orientation.coeffs());
+    }
+  }
+  // A Fixed transition of the same stances is another key: not there.
+  TransitionDesign fixed = t.design;
+  fixed.kind = TransitionDesign::Kind::Fixed;
+  EXPECT_FALSE(memo.find(transitionKey(plan, fixed)).has_value());
+
+  auto refusedAt = [&](transitions_t bad, const std::string& field) {
+    TransitionMemo empty(opt, true, true);
+    try {
+      convert::fillMemo(bad, plan, sc, empty);
+      ADD_FAILURE() << "accepted; expected a refusal at " << field;
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(empty.size(), 0u) << field;
+  };
+  transitions_t two = m;  // a good transition first: all or none
+  two.transitions.push_back(m.transitions[0]);
+  two.num_transitions = 2;
+  transitions_t bad = two;
+  bad.transitions[1].to = 2;
+  refusedAt(bad, "transitions[1].from");
+  bad = two;
+  bad.transitions[1].pieces[1].contacts[0].spot = "tail";
+  refusedAt(bad, "transitions[1].pieces[1].contacts[0].spot");
+  bad = two;
+  bad.transitions[1].pieces[0].knots[2].num_joints -= 1;
+  bad.transitions[1].pieces[0].knots[2].joints.pop_back();
+  refusedAt(bad, "transitions[1].pieces[0].knots[2]");
+}
+#endif

@@ -26,6 +26,7 @@
 #include "acyclic/progress_t.hpp"
 #include "acyclic/request_t.hpp"
 #include "acyclic/trajectory_t.hpp"
+#include "acyclic/transitions_t.hpp"
 #include "channels.hpp"
 #include "processes/lcm_process.h"
 
@@ -114,6 +115,26 @@ plan_t plan() {
   s.configuration = config(3);
   m.num_stances = 2;
   m.stances = {s, s};
+  return m;
+}
+transitions_t transitions() {
+  transitions_t m{};
+  m.options = "acyclic.transition-options/1;steps=0x1.4p+4;";
+  transition_t t{};
+  t.from = 0;
+  t.to = 1;
+  t.move = true;
+  t.how = "as planned";
+  transition_piece_t p{};
+  p.stance = 1;
+  p.num_contacts = 1;
+  p.contacts = {contact("r_sole", 0)};
+  p.num_knots = 2;
+  p.knots = {config(3), config(3)};
+  t.num_pieces = 2;
+  t.pieces = {p, p};
+  m.num_transitions = 2;
+  m.transitions = {t, t};
   return m;
 }
 trajectory_t trajectory(int joints = 3, int samples = 4) {
@@ -293,6 +314,7 @@ TEST(LcmDecodeFuzz, EveryTypeSurvivesMutationsWithinAnAllocationBound) {
   fuzz(config(5), 6, 500);
   fuzz(contact("r_sole", 2), 7, 500);
   fuzz(trajectory(), 8, 1000);
+  fuzz(transitions(), 16, 1000);
   fuzz(phase(), 9, 500);
   fuzz(progress(), 10, 500);
   fuzz(processStatus(), 11, 500);
