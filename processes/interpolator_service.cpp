@@ -1,14 +1,18 @@
 #include "processes/interpolator_service.h"
 
+#include <map>
 #include <memory>
 
 #include "acyclic/cancel_t.hpp"
 #include "acyclic/plan_t.hpp"
 #include "acyclic/progress_t.hpp"
 #include "acyclic/trajectory_t.hpp"
+#include "acyclic/transitions_t.hpp"
+#include "interpolator/transition_memo.h"
 #include "lcmtypes/channels.hpp"
 #include "processes/lcm_convert.h"
 #include "processes/lcm_process.h"
+#include "processes/transitions_message.h"
 
 namespace acyclic {
 
@@ -31,6 +35,7 @@ class InterpolatorService : public proc::Service {
  public:
   InterpolatorService(proc::Bus& bus, InterpolatorOptionsFor o) : proc::Service(bus, kProcess), options_(std::move(o)) {
     bus.lcm().subscribe(channels::kPlan, &InterpolatorService::onPlan, this);
+    bus.lcm().subscribe(channels::kTransitions, &InterpolatorService::onTransitions, this);
     bus.lcm().subscribe(channels::kCancel, &InterpolatorService::onCancel, this);
     status_.ready();
   }
@@ -44,6 +49,42 @@ class InterpolatorService : public proc::Service {
     m.status = code;
     m.reason = reason;
     bus_.publish(channels::kTrajectory, m);
+  }
+
+  // Kept until the plan of the same request comes (the planner sends them
+  // just before it); a few at most.
+  void onTransitions(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    transitions_t m;
+    if (!proc::decode(rb, channel, m, status_)) return;
+    transitions_.erase(m.request_id);
+    transitions_.emplace(m.request_id, std::move(m));
+    while (transitions_.size() > kKeptTransitions) transitions_.erase(transitions_.begin());
+  }
+
+  // A memo of the planner's transitions for this plan, under these options;
+  // none when it sent none, or solved them with other options, or sent a
+  // message that does not read (said on ACYCLIC_STATUS: the plan is then
+  // interpolated without them, to the same result).
+  std::shared_ptr<TransitionMemo> plannersTransitions(std::int64_t id, const Plan& plan, const Scenario& sc,
+                                                      const InterpolatorOptions& options) {
+    const auto t = transitions_.find(id);
+    if (t == transitions_.end()) return nullptr;
+    const transitions_t m = std::move(t->second);
+    transitions_.erase(t);
+    const std::string what = "request " + std::to_string(id) + ": the planner's " +
+                             std::to_string(m.num_transitions) + " transitions (ACYCLIC_TRANSITIONS)";
+    if (m.options != outcomeOptionsText(options)) {
+      proc::log(kProcess, what + " were solved with other options than this interpolator's: solving them here");
+      return nullptr;
+    }
+    auto memo = std::make_shared<TransitionMemo>(options, true, /*check_on_use=*/true);
+    try {
+      convert::fillMemo(m, plan, sc, *memo);
+    } catch (const std::exception& e) {
+      status_.error(id, what + " not used: " + e.what());
+      return nullptr;
+    }
+    return memo;
   }
 
   void onPlan(const lcm::ReceiveBuffer* rb, const std::string& channel) {
@@ -65,11 +106,15 @@ class InterpolatorService : public proc::Service {
       answerError(m.request_id, trajectory_t::INVALID_INPUT, std::string("the plan cannot be read: ") + e.what());
       return;
     }
+    const InterpolatorOptions options = options_(*sc);
+    const std::shared_ptr<TransitionMemo> memo = plannersTransitions(m.request_id, *plan, *sc, options);
     proc::log(kProcess, "request " + std::to_string(m.request_id) + ": interpolating " +
-                            std::to_string(plan->stances.size()) + " stances");
+                            std::to_string(plan->stances.size()) + " stances" +
+                            (memo ? ", with the " + std::to_string(memo->size()) + " transitions the planner verified"
+                                  : std::string()));
     status_.busy(m.request_id);
     const std::int64_t id = m.request_id;
-    worker_.start(id, [this, id, sc, plan](const std::atomic<bool>& cancel) {
+    worker_.start(id, [this, id, sc, plan, options, memo](const std::atomic<bool>& cancel) {
       trajectory_t out{};
       try {
         std::int64_t last = 0;
@@ -88,7 +133,16 @@ class InterpolatorService : public proc::Service {
           msg.message = "transition " + std::to_string(p.transition) + " of " + std::to_string(p.transitions);
           bus_.publish(channels::kProgress, msg);
         };
-        const InterpolationResult r = interpolate(*plan, *sc, options_(*sc), progress, &cancel);
+        const InterpolationResult r = memo ? interpolate(*plan, *sc, *memo, progress, &cancel)
+                                           : interpolate(*plan, *sc, options, progress, &cancel);
+        if (memo)
+          proc::log(kProcess, "request " + std::to_string(id) + ": " + std::to_string(r.reused) + " of " +
+                                  std::to_string(r.transitions.size()) + " transitions taken from the planner's");
+        // An outcome that fails its check was solved here instead: the
+        // answer stands, but a planner that sends such things is wrong.
+        if (r.refused > 0)
+          status_.error(id, std::to_string(r.refused) + " of the planner's transitions failed their check and were "
+                            "solved here; the first: " + r.refused_reason);
         if (r.success()) out = convert::toMessage(r.trajectory, *sc);
         out.status = trajectoryStatus(r.status);
         out.reason = r.reason;
@@ -118,7 +172,9 @@ class InterpolatorService : public proc::Service {
       proc::log(kProcess, "request " + std::to_string(worker_.current()) + ": cancelled (" + c.reason + ")");
   }
 
+  static constexpr std::size_t kKeptTransitions = 4;
   InterpolatorOptionsFor options_;
+  std::map<std::int64_t, transitions_t> transitions_;  // by request id
 };
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "lcmtypes/channels.hpp"
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
 #include "interpolator/plan_verifier.h"
+#include "processes/transitions_message.h"
 #endif
 #include "planner/search/planner_parameters.h"
 #include "processes/lcm_convert.h"
@@ -85,6 +86,12 @@ int8_t planStatus(PlanningResult::Status s) {
   return plan_t::ERROR;
 }
 
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+using transitionsMessage = transitions_t;
+#else
+struct transitionsMessage {};  // nothing to send without the interpolator
+#endif
+
 class PlannerService : public proc::Service {
  public:
   PlannerService(proc::Bus& bus, PlannerOverrides o) : proc::Service(bus, kProcess), overrides_(o) {
@@ -112,6 +119,13 @@ class PlannerService : public proc::Service {
   }
 
  private:
+  // A request's parameters, and the memo its verification keeps the motion
+  // of what it solves in (none without the interpolator): sent with the plan.
+  struct Setup {
+    PlannerParameters params;
+    std::shared_ptr<TransitionMemo> memo;
+  };
+
   // An answer without a plan: refused, invalid input, error.
   void refuse(const request_t& req, int8_t code, const std::string& reason) {
     status_.error(req.request_id, reason);
@@ -141,13 +155,19 @@ class PlannerService : public proc::Service {
       return;
     }
     auto sc = std::make_shared<Scenario>();
-    PlannerParameters params;
+    Setup setup;
+    PlannerParameters& params = setup.params;
     try {
       *sc = Scenario::loadText(req.scenario_yaml,
                                "request " + std::to_string(req.request_id) + " (" + req.scenario_name + ")",
                                req.base_path);
       if (req.seed >= 0) sc->seed = static_cast<std::uint64_t>(req.seed);
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+      // The verification keeps the motion of what it solves, for the interpolator.
+      params = overrides_.apply(*sc, req.time_budget_s, &setup.memo);
+#else
       params = overrides_.apply(*sc, req.time_budget_s);
+#endif
     } catch (const std::exception& e) {
       refuse(req, plan_t::INVALID_INPUT, std::string("the scenario does not load: ") + e.what());
       return;
@@ -168,17 +188,17 @@ class PlannerService : public proc::Service {
         std::vector<Configuration> postures;
         early = earlyGuideProblem(guide, *sc, postures);
         if (early.empty()) {
-          planOnGuide(req, sc, params, guide, postures);
+          planOnGuide(req, sc, setup, guide, postures);
           return;
         }
         status_.error(req.request_id, "an ACYCLIC_GUIDE with its id came before it and is not used: " + early);
       }
       proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " + sc->name +
                               " has no key postures: waiting for its ACYCLIC_GUIDE");
-      waiting_ = Waiting{req, sc, params, proc::nowMicros(), early};
+      waiting_ = Waiting{req, sc, setup, proc::nowMicros(), early};
       return;
     }
-    startPlanning(req, sc, params);
+    startPlanning(req, sc, setup);
   }
 
   // A guide's key postures for the scenario; throws FormatError naming the field.
@@ -208,8 +228,7 @@ class PlannerService : public proc::Service {
     return "";
   }
 
-  void useGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params,
-                const guide_t& g) {
+  void useGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const Setup& setup, const guide_t& g) {
     if (g.status != guide_t::OK) {
       refuse(req, plan_t::NO_SOLUTION, "no guide: " + g.reason);
       status_.idle();
@@ -223,15 +242,15 @@ class PlannerService : public proc::Service {
       status_.idle();
       return;
     }
-    planOnGuide(req, sc, params, g, q);
+    planOnGuide(req, sc, setup, g, q);
   }
   // The guide's key postures (read from g) into the scenario, then the search.
-  void planOnGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params,
-                   const guide_t& g, const std::vector<Configuration>& postures) {
+  void planOnGuide(const request_t& req, const std::shared_ptr<Scenario>& sc, const Setup& setup, const guide_t& g,
+                   const std::vector<Configuration>& postures) {
     sc->key_postures.insert(sc->key_postures.end(), postures.begin(), postures.end());
     proc::log(kProcess, "request " + std::to_string(req.request_id) + ": guide of " +
                             std::to_string(g.num_postures) + " key postures (" + g.source + ")");
-    startPlanning(req, sc, params);
+    startPlanning(req, sc, setup);
   }
 
   void onGuide(const lcm::ReceiveBuffer* rb, const std::string& channel) {
@@ -240,18 +259,21 @@ class PlannerService : public proc::Service {
     if (waiting_ && waiting_->req.request_id == g.request_id) {
       const Waiting w = *waiting_;
       waiting_.reset();
-      useGuide(w.req, w.sc, w.params, g);
+      useGuide(w.req, w.sc, w.setup, g);
       return;
     }
     guides_[g.request_id] = g;  // it may come before its request
     while (guides_.size() > 16) guides_.erase(guides_.begin());
   }
 
-  void startPlanning(const request_t& req, const std::shared_ptr<Scenario>& sc, const PlannerParameters& params) {
+  void startPlanning(const request_t& req, const std::shared_ptr<Scenario>& sc, const Setup& setup) {
     proc::log(kProcess, "request " + std::to_string(req.request_id) + ": planning " + sc->name);
     status_.busy(req.request_id);
-    worker_.start(req.request_id, [this, req, sc, params](const std::atomic<bool>& cancel) {
+    const PlannerParameters params = setup.params;
+    const std::shared_ptr<TransitionMemo> memo = setup.memo;
+    worker_.start(req.request_id, [this, req, sc, params, memo](const std::atomic<bool>& cancel) {
       plan_t m{};
+      std::optional<transitionsMessage> transitions;
       try {
         ContactPlanner planner(*sc, params);
         std::int64_t last_progress = 0;
@@ -278,6 +300,12 @@ class PlannerService : public proc::Service {
           Plan plan = r.plan;
           plan.scenario = req.scenario_name;
           m = convert::toMessage(plan, *sc);
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+          if (memo) {
+            const auto known = convert::transitionsToSend(plan, *sc, *memo);
+            if (!known.empty()) transitions = convert::toMessage(known, memo->options(), *sc);
+          }
+#endif
         }
         m.status = planStatus(r.status);
         m.reason = r.reason;
@@ -304,6 +332,16 @@ class PlannerService : public proc::Service {
       m.scenario_yaml = req.scenario_yaml;
       m.base_path = req.base_path;
       if (worker_.abandoned()) return;  // stopping: no answer for unfinished work
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+      // Before the plan, so that the interpolator has them when the plan comes.
+      if (transitions && m.status == plan_t::OK) {
+        transitions->utime = proc::nowMicros();
+        transitions->request_id = req.request_id;
+        proc::log(kProcess, "request " + std::to_string(req.request_id) + ": " +
+                                std::to_string(transitions->num_transitions) + " verified transitions sent");
+        bus_.publish(channels::kTransitions, *transitions);
+      }
+#endif
       bus_.publish(channels::kPlan, m);
       status_.served();
       status_.idle();
@@ -329,7 +367,7 @@ class PlannerService : public proc::Service {
   struct Waiting {
     request_t req;
     std::shared_ptr<Scenario> sc;
-    PlannerParameters params;
+    Setup setup;
     std::int64_t since_us;
     std::string early_guide;  // why a guide with its id that came before it was not used
   };

@@ -24,6 +24,7 @@
 #include "acyclic/process_status_t.hpp"
 #include "acyclic/request_t.hpp"
 #include "acyclic/trajectory_t.hpp"
+#include "acyclic/transitions_t.hpp"
 #include "lcmtypes/channels.hpp"
 #include "planner/scene/scenario.h"
 #include "processes/lcm_process.h"
@@ -104,8 +105,9 @@ struct Client {
 
 struct Processes {
   Supervisor sup{[](const std::string& s) { std::fprintf(stderr, "[supervisor] %s\n", s.c_str()); }};
-  void start(const std::string& name, std::vector<std::string> extra = {}) {
-    ChildSpec c{name, {exe(name), "--lcm"}, ""};
+  // `log`: the process's stdout and stderr go there (empty: the test's).
+  void start(const std::string& name, std::vector<std::string> extra = {}, const std::string& log = "") {
+    ChildSpec c{name, {exe(name), "--lcm"}, log};
     c.argv.insert(c.argv.end(), extra.begin(), extra.end());
     c.respawn = false;
     sup.start(c);
@@ -142,8 +144,86 @@ TEST(Pipeline, LaunchOnASmallScenarioWritesAValidPlanTrajectoryAndLog) {
   EXPECT_EQ(count[channels::kPlan], 1);
   EXPECT_GE(count[channels::kStatus], 2);
   if (haveInterpolator()) {
+    EXPECT_EQ(count[channels::kTransitions], 1);  // the planner's, with its plan
     EXPECT_EQ(count[channels::kTrajectory], 1);
   }
+}
+
+// The planner sends the transitions its verification solved
+// (ACYCLIC_TRANSITIONS) just before its plan, and the interpolator takes
+// them instead of solving them: its trajectory is the one it gives the same
+// plan without them, bit for bit. Transitions that fail the interpolator's
+// check (a knot lifted off the floor) are solved there instead, to the same
+// trajectory, and said on ACYCLIC_STATUS; transitions solved under other
+// options are not used.
+TEST(Pipeline, TheInterpolatorTakesThePlannersTransitionsToTheTrajectoryItWouldSolve) {
+  REQUIRE_NETNS();
+  if (!haveInterpolator()) GTEST_SKIP() << "built without the interpolator";
+  test::TempDir dir;
+  Client c;
+  std::map<std::int64_t, transitions_t> sent;
+  struct Ear {
+    std::map<std::int64_t, transitions_t>* sent;
+    void on(const lcm::ReceiveBuffer*, const std::string&, const transitions_t* m) { (*sent)[m->request_id] = *m; }
+  } ear{&sent};
+  c.bus.lcm().subscribe(channels::kTransitions, &Ear::on, &ear);
+  Processes p;
+  const std::string interp_log = dir.path() + "/interpolator.log";
+  p.start("acyclic-planner");
+  p.start("acyclic-interpolator", {}, interp_log);
+  for (const char* n : {"acyclic-planner", "acyclic-interpolator"})
+    ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(n, process_status_t::IDLE); }, 20)) << n;
+
+  c.bus.publish(channels::kRequest, c.request(1, "models/scenarios/step_forward.yaml"));
+  ASSERT_TRUE(c.waitFor([&] { return c.trajectories.count(1) > 0; }, 120));
+  ASSERT_EQ(c.plans[1].status, +plan_t::OK) << c.plans[1].reason;
+  ASSERT_EQ(c.trajectories[1].status, +trajectory_t::OK) << c.trajectories[1].reason;
+  ASSERT_EQ(sent.count(1), 1u);
+  const transitions_t planners = sent[1];
+  ASSERT_GT(planners.num_transitions, 0);
+  c.waitFor([] { return false; }, 0.3);  // its log line written
+  const std::string taken = std::to_string(planners.num_transitions) + " of " +
+                            std::to_string(planners.num_transitions) + " transitions taken from the planner's";
+  EXPECT_NE(test::readFile(interp_log).find(taken), std::string::npos) << test::readFile(interp_log);
+
+  // The same plan again under other ids: without transitions; with them
+  // tampered; with them under other options.
+  auto again = [&](std::int64_t id, const transitions_t* t) {
+    if (t) {
+      transitions_t m = *t;
+      m.request_id = id;
+      c.bus.publish(channels::kTransitions, m);
+    }
+    plan_t plan = c.plans[1];
+    plan.request_id = id;
+    c.bus.publish(channels::kPlan, plan);
+    EXPECT_TRUE(c.waitFor([&] { return c.trajectories.count(id) > 0; }, 120)) << id;
+    trajectory_t tr = c.trajectories[id];
+    EXPECT_EQ(tr.status, +trajectory_t::OK) << id << ": " << tr.reason;
+    tr.utime = c.trajectories[1].utime;
+    tr.request_id = 1;
+    EXPECT_TRUE(test::encoded(tr) == test::encoded(c.trajectories[1])) << id << ": not the same trajectory";
+  };
+  again(2, nullptr);
+  transitions_t tampered = planners;
+  bool lifted = false;
+  for (auto& t : tampered.transitions)
+    for (auto& piece : t.pieces)
+      if (!lifted && piece.num_knots >= 3) piece.knots[1].base_position[2] += 0.05, lifted = true;
+  ASSERT_TRUE(lifted);
+  again(3, &tampered);
+  const process_status_t* e = c.error("acyclic-interpolator", "failed their check");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->request_id, 3);
+  EXPECT_NE(e->reason.find("1 of the planner's transitions"), std::string::npos) << e->reason;
+  transitions_t other = planners;
+  other.options += "steps=0x1p+0;";
+  again(4, &other);
+  c.waitFor([] { return false; }, 0.3);
+  EXPECT_NE(test::readFile(interp_log).find("request 4: the planner's " + std::to_string(planners.num_transitions) +
+                                            " transitions (ACYCLIC_TRANSITIONS) were solved with other options"),
+            std::string::npos)
+      << test::readFile(interp_log);
 }
 
 // The scenario with non-foot contacts that is small enough for the suite:
@@ -438,6 +518,19 @@ void fuzzServiceChannels(Client& c) {
   plan.num_stances = 1;
   plan.stances = {s};
   publishMalformed(c, channels::kPlan, plan, 4);
+  transitions_t t{};
+  t.request_id = 101;
+  t.options = "fuzz";
+  transition_t one{};
+  one.to = 1;
+  transition_piece_t piece{};
+  piece.num_knots = 1;
+  piece.knots = {g.postures[0]};
+  one.num_pieces = 1;
+  one.pieces = {piece};
+  t.num_transitions = 1;
+  t.transitions = {one};
+  publishMalformed(c, channels::kTransitions, t, 5);
 }
 
 }  // namespace
@@ -469,7 +562,8 @@ TEST(Pipeline, FuzzOnEveryChannelLeavesEveryServiceUpAnsweringWithBoundedMemory)
     return true;
   };
   for (int round = 0; round < 15 && !allReported(); ++round) {
-    for (const char* channel : {channels::kRequest, channels::kCancel, channels::kGuide, channels::kPlan})
+    for (const char* channel :
+         {channels::kRequest, channels::kCancel, channels::kGuide, channels::kPlan, channels::kTransitions})
       c.bus.publishRaw(channel, garbage, sizeof garbage);
     c.waitFor(allReported, 1.1);
   }
