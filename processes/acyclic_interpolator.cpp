@@ -39,7 +39,9 @@ int main(int argc, char** argv) {
       "LCM mode: --lcm interpolates every ACYCLIC_PLAN with status OK and answers ACYCLIC_TRAJECTORY (same\n"
       "request id), with ACYCLIC_PROGRESS, ACYCLIC_STATUS at 1 Hz and on errors, and ACYCLIC_CANCEL. One\n"
       "plan at a time: a plan that arrives while one is interpolated is refused (ACYCLIC_TRAJECTORY with\n"
-      "status ERROR and the reason). Exits 0 on SIGINT/SIGTERM."};
+      "status ERROR and the reason). The planner's ACYCLIC_TRANSITIONS for the same request, solved under\n"
+      "this interpolator's options, are taken instead of solved, each checked first (the same trajectory).\n"
+      "Exits 0 on SIGINT/SIGTERM."};
   std::string in, out, scenario_path;
   bool no_filter = false, quiet = false, verbose = false;
   bool lcm_mode = false;

@@ -4,7 +4,8 @@
 //   (reason printed) or a refused plan not written (--keep-refused), 2 bad input.
 //   --trajectory T: the plan interpolated too, reusing the transitions its
 //   verification solved (exit 1 when no trajectory is made; the plan stays).
-//   LCM mode (--lcm): serves ACYCLIC_REQUEST, answers ACYCLIC_PLAN, reports on
+//   LCM mode (--lcm): serves ACYCLIC_REQUEST, answers ACYCLIC_PLAN (preceded by
+//   ACYCLIC_TRANSITIONS, the transitions it verified), reports on
 //   ACYCLIC_PROGRESS and ACYCLIC_STATUS, obeys ACYCLIC_CANCEL (planner_service).
 #include <CLI/CLI.hpp>
 
@@ -76,7 +77,9 @@ int main(int argc, char** argv) {
       "LCM mode: --lcm serves ACYCLIC_REQUEST and answers ACYCLIC_PLAN (with the request id), with\n"
       "ACYCLIC_PROGRESS during the search, ACYCLIC_STATUS at 1 Hz and on every error, and ACYCLIC_CANCEL.\n"
       "One request at a time: a request that arrives while one runs is refused (ACYCLIC_PLAN with\n"
-      "status ERROR and the reason, and a status error). Exits 0 on SIGINT/SIGTERM."};
+      "status ERROR and the reason, and a status error). A plan is preceded by ACYCLIC_TRANSITIONS, the\n"
+      "transitions its verification solved, so that the interpolator need not solve them again.\n"
+      "Exits 0 on SIGINT/SIGTERM."};
   std::string in, out, guide_path, url = acyclic::proc::defaultLcmUrl();
   bool lcm_mode = false;
   acyclic::PlannerOverrides o;
