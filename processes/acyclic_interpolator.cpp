@@ -50,6 +50,9 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "trajectory file to write (acyclic.trajectory/1), file mode")
       ->check(acyclic::proc::InWritableDirectory());
   app.add_flag("--lcm", lcm_mode, "serve ACYCLIC_PLAN on LCM instead of the file mode");
+  bool solve_all = false;
+  app.add_flag("--no-planner-transitions", solve_all,
+               "LCM mode: ignore the planner's ACYCLIC_TRANSITIONS and solve every transition here");
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--scenario", scenario_path,
                  "scenario file (default: the plan's 'scenario' field, beside the plan, else in the current directory)");
@@ -136,7 +139,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     acyclic::proc::installSignalHandlers();
-    return acyclic::serveInterpolator(url, options_for);
+    return acyclic::serveInterpolator(url, options_for, !solve_all);
   }
   if (in.empty() || out.empty()) {
     std::fprintf(stderr, "acyclic-interpolator: give --in PLAN --out TRAJECTORY (file mode) or --lcm; see --help\n");

@@ -2,10 +2,11 @@
 // processes and checks that they answer exactly as logged: each logged
 // ACYCLIC_REQUEST goes to a fresh acyclic-planner, whose ACYCLIC_PLAN must
 // equal the logged one (stances, contacts, forces, postures, node and call
-// counts; not wall time); each logged ACYCLIC_PLAN that the log shows
-// interpolated goes to a fresh acyclic-interpolator, whose ACYCLIC_TRAJECTORY
-// must equal the logged one. The planner is deterministic, so any difference
-// is a regression.
+// counts; not wall time); where the log shows the plan interpolated, a fresh
+// acyclic-interpolator interpolates the fresh planner's plan (with the
+// transitions that planner verified, or, with --solve-transitions, solving
+// them all itself), and its ACYCLIC_TRAJECTORY must equal the logged one.
+// Both are deterministic, so any difference is a regression.
 // Exit: 0 identical, 1 a difference or no answer, 2 bad input.
 #include <CLI/CLI.hpp>
 #include <unistd.h>
@@ -96,6 +97,11 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", url, "LCM URL (default: $LCM_DEFAULT_URL, else LCM's default)");
   app.add_option("--bin-dir", bin_dir, "where the acyclic-* executables are (default: beside this one)");
   app.add_option("--timeout", timeout_s, "seconds to wait for each answer")->capture_default_str();
+  bool solve_transitions = false;
+  app.add_flag("--solve-transitions", solve_transitions,
+               "the fresh interpolator solves every transition itself (acyclic-interpolator\n"
+               "--no-planner-transitions) instead of taking those the fresh planner verified: replays the\n"
+               "interpolator's own solving too (slower; the same trajectory)");
   std::string base_path;
   app.add_option("--base-path", base_path,
                  "resolve the logged scenarios' relative paths (robot, scene) against this folder instead of the one\n"
@@ -152,6 +158,8 @@ int main(int argc, char** argv) {
       if (std::string(name) == "acyclic-interpolator" && !interpolate) continue;
       ChildSpec c{name, {(fs::path(bin_dir) / name).string(), "--lcm"}, ""};
       if (!url.empty()) c.argv.insert(c.argv.end(), {"--lcm-url", url});
+      if (solve_transitions && std::string(name) == "acyclic-interpolator")
+        c.argv.push_back("--no-planner-transitions");
       c.respawn = false;
       sup.start(c);
     }

@@ -33,9 +33,13 @@ int8_t trajectoryStatus(InterpolationResult::Status s) {
 
 class InterpolatorService : public proc::Service {
  public:
-  InterpolatorService(proc::Bus& bus, InterpolatorOptionsFor o) : proc::Service(bus, kProcess), options_(std::move(o)) {
+  struct Setup {
+    InterpolatorOptionsFor options;
+    bool planner_transitions;
+  };
+  InterpolatorService(proc::Bus& bus, const Setup& setup) : proc::Service(bus, kProcess), options_(setup.options) {
     bus.lcm().subscribe(channels::kPlan, &InterpolatorService::onPlan, this);
-    bus.lcm().subscribe(channels::kTransitions, &InterpolatorService::onTransitions, this);
+    if (setup.planner_transitions) bus.lcm().subscribe(channels::kTransitions, &InterpolatorService::onTransitions, this);
     bus.lcm().subscribe(channels::kCancel, &InterpolatorService::onCancel, this);
     status_.ready();
   }
@@ -179,8 +183,9 @@ class InterpolatorService : public proc::Service {
 
 }  // namespace
 
-int serveInterpolator(const std::string& lcm_url, const InterpolatorOptionsFor& options) {
-  return proc::serve<InterpolatorService>(lcm_url, kProcess, channels::kPlan, options);
+int serveInterpolator(const std::string& lcm_url, const InterpolatorOptionsFor& options, bool planner_transitions) {
+  return proc::serve<InterpolatorService>(lcm_url, kProcess, channels::kPlan,
+                                         InterpolatorService::Setup{options, planner_transitions});
 }
 
 }  // namespace acyclic

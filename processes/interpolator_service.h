@@ -13,6 +13,9 @@ namespace acyclic {
 using InterpolatorOptionsFor = std::function<InterpolatorOptions(const Scenario&)>;
 
 // Serves until SIGINT/SIGTERM. Returns the process's exit status.
-int serveInterpolator(const std::string& lcm_url, const InterpolatorOptionsFor& options);
+// `planner_transitions`: take the planner's ACYCLIC_TRANSITIONS (checked)
+// instead of solving them; off, every transition is solved here.
+int serveInterpolator(const std::string& lcm_url, const InterpolatorOptionsFor& options,
+                      bool planner_transitions = true);
 
 }  // namespace acyclic

@@ -146,6 +146,11 @@ TEST(Pipeline, LaunchOnASmallScenarioWritesAValidPlanTrajectoryAndLog) {
   if (haveInterpolator()) {
     EXPECT_EQ(count[channels::kTransitions], 1);  // the planner's, with its plan
     EXPECT_EQ(count[channels::kTrajectory], 1);
+    // The log replays: its trajectory, made from the planner's transitions,
+    // is the one a fresh interpolator makes solving them all itself.
+    const auto replay = test::runProcess(exe("acyclic-replay") + " " + dir.path() + "/run.lcmlog --solve-transitions");
+    EXPECT_EQ(replay.status, 0) << replay.output;
+    EXPECT_NE(replay.output.find("trajectory identical"), std::string::npos) << replay.output;
   }
 }
 
@@ -224,6 +229,29 @@ TEST(Pipeline, TheInterpolatorTakesThePlannersTransitionsToTheTrajectoryItWouldS
                                             " transitions (ACYCLIC_TRANSITIONS) were solved with other options"),
             std::string::npos)
       << test::readFile(interp_log);
+}
+
+// An interpolator told to solve everything itself (--no-planner-transitions)
+// does not take the planner's transitions, and answers the same.
+TEST(Pipeline, AnInterpolatorToldToSolveEverythingLeavesThePlannersTransitions) {
+  REQUIRE_NETNS();
+  if (!haveInterpolator()) GTEST_SKIP() << "built without the interpolator";
+  test::TempDir dir;
+  Client c;
+  Processes p;
+  const std::string log = dir.path() + "/interpolator.log";
+  p.start("acyclic-planner");
+  p.start("acyclic-interpolator", {"--no-planner-transitions"}, log);
+  for (const char* n : {"acyclic-planner", "acyclic-interpolator"})
+    ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(n, process_status_t::IDLE); }, 20)) << n;
+  c.bus.publish(channels::kRequest, c.request(1, "models/scenarios/step_forward.yaml"));
+  ASSERT_TRUE(c.waitFor([&] { return c.trajectories.count(1) > 0; }, 120));
+  EXPECT_EQ(c.trajectories[1].status, +trajectory_t::OK) << c.trajectories[1].reason;
+  c.waitFor([] { return false; }, 0.3);  // its log line written
+  const std::string text = test::readFile(log);
+  EXPECT_NE(text.find("request 1: interpolating"), std::string::npos) << text;
+  EXPECT_EQ(text.find("transitions the planner verified"), std::string::npos) << text;
+  EXPECT_EQ(text.find("taken from the planner's"), std::string::npos) << text;
 }
 
 // The scenario with non-foot contacts that is small enough for the suite:
