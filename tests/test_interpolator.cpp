@@ -1378,6 +1378,28 @@ void expectSameTrajectory(const Trajectory& a, const Trajectory& b) {
 }
 }  // namespace
 
+namespace {
+// The memo tests' case: a step on the floor as the planner's file holds it
+// (the plan the verifier solves), and its interpolation at 8 steps from
+// scratch, made once.
+struct MemoCase {
+  InterpolatorOptions opt;
+  Plan plan;
+  InterpolationResult fresh;
+};
+const MemoCase& memoCase() {
+  static const MemoCase c = [] {
+    const Scenario& sc = floorScenario();
+    MemoCase m;
+    m.opt.steps = 8;
+    m.plan = planFromJson(planToJson(stepPlan(sc, 0.15), sc), "round trip", sc);
+    m.fresh = interpolate(m.plan, sc, m.opt);
+    return m;
+  }();
+  return c;
+}
+}  // namespace
+
 // A memo shared by the verifier and the interpolator (transition_memo.h):
 // what the verifier solved is taken from it, none solved again, and the
 // trajectory is the one interpolating from scratch gives, bit for bit. An
@@ -1385,11 +1407,7 @@ void expectSameTrajectory(const Trajectory& a, const Trajectory& b) {
 // motion (a verifier's own) cannot be interpolated with.
 TEST(TransitionMemo, AVerifiedPlanIsInterpolatedWithoutSolvingItsTransitionsAgain) {
   const Scenario& sc = floorScenario();
-  InterpolatorOptions opt;
-  opt.steps = 8;
-  // As the planner's file holds it: the plan the verifier solves.
-  const Plan plan = planFromJson(planToJson(stepPlan(sc, 0.15), sc), "round trip", sc);
-  const InterpolationResult fresh = interpolate(plan, sc, opt);
+  const auto& [opt, plan, fresh] = memoCase();
   ASSERT_TRUE(fresh.success()) << fresh.reason;
   ASSERT_GT(fresh.trajectory.stats.posture_calls, 0);
   EXPECT_EQ(fresh.reused, 0);
@@ -1432,10 +1450,7 @@ TEST(TransitionMemo, AVerifiedPlanIsInterpolatedWithoutSolvingItsTransitionsAgai
 // same trajectory.
 TEST(TransitionMemo, TransitionsFromElsewhereAreCheckedAndABadOneIsSolvedHereInstead) {
   const Scenario& sc = floorScenario();
-  InterpolatorOptions opt;
-  opt.steps = 8;
-  const Plan plan = planFromJson(planToJson(stepPlan(sc, 0.15), sc), "round trip", sc);
-  const InterpolationResult fresh = interpolate(plan, sc, opt);
+  const auto& [opt, plan, fresh] = memoCase();
   ASSERT_TRUE(fresh.success()) << fresh.reason;
 
   TransitionMemo solved(opt);
