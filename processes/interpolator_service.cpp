@@ -1,5 +1,7 @@
 #include "processes/interpolator_service.h"
 
+#include <algorithm>
+#include <deque>
 #include <map>
 #include <memory>
 
@@ -56,13 +58,19 @@ class InterpolatorService : public proc::Service {
   }
 
   // Kept until the plan of the same request comes (the planner sends them
-  // just before it); a few at most.
+  // just before it); the last few to arrive, whatever their ids.
   void onTransitions(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     transitions_t m;
     if (!proc::decode(rb, channel, m, status_)) return;
-    transitions_.erase(m.request_id);
-    transitions_.emplace(m.request_id, std::move(m));
-    while (transitions_.size() > kKeptTransitions) transitions_.erase(transitions_.begin());
+    const std::int64_t id = m.request_id;
+    forgetTransitions(id);
+    transitions_.emplace(id, std::move(m));
+    arrival_.push_back(id);
+    while (arrival_.size() > kKeptTransitions) forgetTransitions(arrival_.front());
+  }
+  void forgetTransitions(std::int64_t id) {
+    transitions_.erase(id);
+    arrival_.erase(std::remove(arrival_.begin(), arrival_.end(), id), arrival_.end());
   }
 
   // A memo of the planner's transitions for this plan, under these options;
@@ -74,7 +82,7 @@ class InterpolatorService : public proc::Service {
     const auto t = transitions_.find(id);
     if (t == transitions_.end()) return nullptr;
     const transitions_t m = std::move(t->second);
-    transitions_.erase(t);
+    forgetTransitions(id);
     const std::string what = "request " + std::to_string(id) + ": the planner's " +
                              std::to_string(m.num_transitions) + " transitions (ACYCLIC_TRANSITIONS)";
     if (m.options != outcomeOptionsText(options)) {
@@ -179,6 +187,7 @@ class InterpolatorService : public proc::Service {
   static constexpr std::size_t kKeptTransitions = 4;
   InterpolatorOptionsFor options_;
   std::map<std::int64_t, transitions_t> transitions_;  // by request id
+  std::deque<std::int64_t> arrival_;                   // their ids, oldest first
 };
 
 }  // namespace

@@ -86,12 +86,6 @@ int8_t planStatus(PlanningResult::Status s) {
   return plan_t::ERROR;
 }
 
-#ifdef ACYCLIC_HAVE_INTERPOLATOR
-using transitionsMessage = transitions_t;
-#else
-struct transitionsMessage {};  // nothing to send without the interpolator
-#endif
-
 class PlannerService : public proc::Service {
  public:
   PlannerService(proc::Bus& bus, PlannerOverrides o) : proc::Service(bus, kProcess), overrides_(o) {
@@ -273,7 +267,9 @@ class PlannerService : public proc::Service {
     const std::shared_ptr<TransitionMemo> memo = setup.memo;
     worker_.start(req.request_id, [this, req, sc, params, memo](const std::atomic<bool>& cancel) {
       plan_t m{};
-      std::optional<transitionsMessage> transitions;
+#ifdef ACYCLIC_HAVE_INTERPOLATOR
+      std::optional<transitions_t> transitions;  // sent just before the plan
+#endif
       try {
         ContactPlanner planner(*sc, params);
         std::int64_t last_progress = 0;

@@ -179,6 +179,15 @@ TEST(Pipeline, TheInterpolatorTakesThePlannersTransitionsToTheTrajectoryItWouldS
   for (const char* n : {"acyclic-planner", "acyclic-interpolator"})
     ASSERT_TRUE(c.waitFor([&] { return c.sawStatus(n, process_status_t::IDLE); }, 20)) << n;
 
+  // Others' transitions for requests that never come, as many as the
+  // interpolator keeps, and with larger ids: the planner's, which come
+  // last, are kept all the same.
+  for (std::int64_t id = 1000; id < 1004; ++id) {
+    transitions_t stray{};
+    stray.request_id = id;
+    stray.options = "another run's";
+    c.bus.publish(channels::kTransitions, stray);
+  }
   c.bus.publish(channels::kRequest, c.request(1, "models/scenarios/step_forward.yaml"));
   ASSERT_TRUE(c.waitFor([&] { return c.trajectories.count(1) > 0; }, 120));
   ASSERT_EQ(c.plans[1].status, +plan_t::OK) << c.plans[1].reason;
