@@ -58,18 +58,24 @@ class InterpolatorService : public proc::Service {
   }
 
   // Kept until the plan of the same request comes (the planner sends them
-  // just before it); the last few to arrive, whatever their ids.
+  // just before it): the last few to arrive, whatever their ids, within a
+  // bound on their bytes (anyone on the bus can send them).
   void onTransitions(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     transitions_t m;
     if (!proc::decode(rb, channel, m, status_)) return;
     const std::int64_t id = m.request_id;
     forgetTransitions(id);
-    transitions_.emplace(id, std::move(m));
+    transitions_.emplace(id, Kept{std::move(m), rb->data_size});
+    kept_bytes_ += rb->data_size;
     arrival_.push_back(id);
-    while (arrival_.size() > kKeptTransitions) forgetTransitions(arrival_.front());
+    while (arrival_.size() > kKeptTransitions || (arrival_.size() > 1 && kept_bytes_ > kKeptBytes))
+      forgetTransitions(arrival_.front());
   }
   void forgetTransitions(std::int64_t id) {
-    transitions_.erase(id);
+    const auto t = transitions_.find(id);
+    if (t == transitions_.end()) return;
+    kept_bytes_ -= t->second.bytes;
+    transitions_.erase(t);
     arrival_.erase(std::remove(arrival_.begin(), arrival_.end(), id), arrival_.end());
   }
 
@@ -81,7 +87,7 @@ class InterpolatorService : public proc::Service {
                                                       const InterpolatorOptions& options) {
     const auto t = transitions_.find(id);
     if (t == transitions_.end()) return nullptr;
-    const transitions_t m = std::move(t->second);
+    const transitions_t m = std::move(t->second.message);
     forgetTransitions(id);
     const std::string what = "request " + std::to_string(id) + ": the planner's " +
                              std::to_string(m.num_transitions) + " transitions (ACYCLIC_TRANSITIONS)";
@@ -184,10 +190,17 @@ class InterpolatorService : public proc::Service {
       proc::log(kProcess, "request " + std::to_string(worker_.current()) + ": cancelled (" + c.reason + ")");
   }
 
+  // chair_paper's (93 transitions) take 0.4 MB.
   static constexpr std::size_t kKeptTransitions = 4;
+  static constexpr std::size_t kKeptBytes = 32u << 20;
+  struct Kept {
+    transitions_t message;
+    std::size_t bytes;  // encoded
+  };
   InterpolatorOptionsFor options_;
-  std::map<std::int64_t, transitions_t> transitions_;  // by request id
-  std::deque<std::int64_t> arrival_;                   // their ids, oldest first
+  std::map<std::int64_t, Kept> transitions_;  // by request id
+  std::deque<std::int64_t> arrival_;          // their ids, oldest first
+  std::size_t kept_bytes_ = 0;
 };
 
 }  // namespace
