@@ -331,28 +331,17 @@ struct Refiner {
 
 }  // namespace
 
-namespace {
-
-// Whether two configurations are the same to within rounding (a knot that
-// starts or ends a transition is its witness, copied).
-bool sameConfiguration(const Configuration& a, const Configuration& b) {
-  constexpr double kTol = 1e-9;
-  if (a.joints.size() != b.joints.size()) return false;
-  return (a.base_position - b.base_position).cwiseAbs().maxCoeff() <= kTol &&
-         (a.base_orientation.coeffs() - b.base_orientation.coeffs()).cwiseAbs().maxCoeff() <= kTol &&
-         (a.joints.size() == 0 || (a.joints - b.joints).cwiseAbs().maxCoeff() <= kTol);
-}
-
-}  // namespace
-
 std::string TransitionSolver::check(const Plan& plan, const TransitionDesign& d, const TransitionOutcome& o) {
   const int n = static_cast<int>(plan.stances.size());
   if (d.from < 0 || d.to <= d.from || d.to >= n) return "its stances are not the plan's";
   if (!o.ok) return "it is not a success";
   const Configuration& start = plan.stances[static_cast<std::size_t>(d.from)].configuration;
   const Configuration& end = plan.stances[static_cast<std::size_t>(d.to)].configuration;
+  // A knot that starts or ends a transition is its witness, copied: the
+  // same to within rounding.
+  auto same = [](const Configuration& a, const Configuration& b) { return distance(a, b) <= 1e-9; };
   if (o.pieces.empty())
-    return sameConfiguration(start, end) ? "" : "it has no motion between witnesses that differ";
+    return same(start, end) ? "" : "it has no motion between witnesses that differ";
   const std::size_t joints = sc_.robot->numJoints();
   const Configuration* last = &start;
   for (std::size_t p = 0; p < o.pieces.size(); ++p) {
@@ -364,7 +353,7 @@ std::string TransitionSolver::check(const Plan& plan, const TransitionDesign& d,
           !q.base_orientation.coeffs().allFinite() || !q.joints.allFinite() ||
           std::abs(q.base_orientation.norm() - 1) > 1e-6)
         return where + "a knot is not a configuration of the robot";
-    if (!sameConfiguration(piece.knots.front(), *last))
+    if (!same(piece.knots.front(), *last))
       return where + (p == 0 ? "it does not start at stance " + std::to_string(d.from) + "'s witness"
                              : "it does not start where the previous piece ended");
     last = &piece.knots.back();
@@ -381,13 +370,13 @@ std::string TransitionSolver::check(const Plan& plan, const TransitionDesign& d,
     for (int i = 0; i <= tp.steps(); ++i) {
       const ValidityReport r = checker_.checkPosture(tp.at(i * opt_.timing.dt), piece.contacts);
       if (r.valid()) continue;
-      for (const auto& part : r.parts)
-        if (part.checked && !part.ok())
-          return where + "sample " + std::to_string(i) + " is not valid: " + part.name + ": " + part.violations[0];
-      return where + "sample " + std::to_string(i) + " is not valid";
+      std::string why;
+      std::vector<int> links;
+      Refiner::failure(r, &why, &links);  // as the solver's own samples say it
+      return where + "sample " + std::to_string(i) + " is not valid: " + why;
     }
   }
-  if (!sameConfiguration(*last, end)) return "it does not end at stance " + std::to_string(d.to) + "'s witness";
+  if (!same(*last, end)) return "it does not end at stance " + std::to_string(d.to) + "'s witness";
   return "";
 }
 
