@@ -27,10 +27,8 @@ PlanVerdict TransitionVerifier::verify(const Plan& found, const std::atomic<bool
   // in memory failed to interpolate from its file).
   const Plan plan = planFromJson(planToJson(found, *sc_), "the plan being verified", *sc_);
   PlanVerdict v;
-  std::vector<int> kept;
-  for (int k = 0; k < static_cast<int>(plan.stances.size()); ++k) kept.push_back(k);
   std::vector<TransitionDesign> designs;
-  if (std::string why = designTransitions(plan, kept, designs); !why.empty()) {
+  if (std::string why = designTransitions(plan, designs); !why.empty()) {
     // Consecutive stances the planner wrote always differ by one contact: a
     // plan the interpolator cannot design is the planner's bug.
     throw std::logic_error("the plan's sequence cannot be interpolated: " + why);

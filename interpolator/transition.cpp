@@ -65,6 +65,12 @@ double distance(const Configuration& a, const Configuration& b) {
 
 }  // namespace
 
+std::string designTransitions(const Plan& plan, std::vector<TransitionDesign>& out) {
+  std::vector<int> kept(plan.stances.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) kept[k] = static_cast<int>(k);
+  return designTransitions(plan, kept, out);
+}
+
 std::string designTransitions(const Plan& plan, const std::vector<int>& kept, std::vector<TransitionDesign>& out) {
   out.clear();
   for (std::size_t i = 0; i + 1 < kept.size(); ++i) {

@@ -76,6 +76,8 @@ struct TransitionDesign {
 // Designs the transitions between consecutive kept stances. Returns an empty
 // string, or why the sequence cannot be interpolated (naming the stances).
 std::string designTransitions(const Plan& plan, const std::vector<int>& kept, std::vector<TransitionDesign>& out);
+// The same with every stance kept: the plan as the planner verifies it.
+std::string designTransitions(const Plan& plan, std::vector<TransitionDesign>& out);
 
 struct MotionPiece {
   std::vector<Configuration> knots;  // travelled from rest to rest

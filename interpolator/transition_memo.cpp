@@ -58,11 +58,9 @@ std::string outcomeOptionsText(const InterpolatorOptions& o) {
 }
 
 std::vector<RememberedTransition> rememberedTransitions(const Plan& plan, const TransitionMemo& memo) {
-  std::vector<int> kept(plan.stances.size());
-  for (std::size_t k = 0; k < kept.size(); ++k) kept[k] = static_cast<int>(k);
   std::vector<TransitionDesign> designs;
   std::vector<RememberedTransition> out;
-  if (!designTransitions(plan, kept, designs).empty()) return out;
+  if (!designTransitions(plan, designs).empty()) return out;
   for (const TransitionDesign& d : designs)
     if (std::optional<TransitionOutcome> o = memo.find(transitionKey(plan, d)); o && o->ok)
       out.push_back({d, std::move(*o)});
