@@ -47,14 +47,22 @@ contact_t toMessage(const ContactSpec& s, const Scenario& sc) {
   return c;
 }
 
-configuration_t toMessage(const Configuration& q) {
+configuration_t toMessageAsIs(const Configuration& q) {
   configuration_t m{};
-  const Eigen::Quaterniond o = q.base_orientation.normalized();
+  const Eigen::Quaterniond& o = q.base_orientation;
   for (int k = 0; k < 3; ++k) m.base_position[k] = q.base_position[k];
   m.base_orientation[0] = o.w(), m.base_orientation[1] = o.x(), m.base_orientation[2] = o.y(),
   m.base_orientation[3] = o.z();
   m.num_joints = static_cast<int32_t>(q.joints.size());
   m.joints.assign(q.joints.data(), q.joints.data() + q.joints.size());
+  return m;
+}
+
+configuration_t toMessage(const Configuration& q) {
+  configuration_t m = toMessageAsIs(q);
+  const Eigen::Quaterniond o = q.base_orientation.normalized();
+  m.base_orientation[0] = o.w(), m.base_orientation[1] = o.x(), m.base_orientation[2] = o.y(),
+  m.base_orientation[3] = o.z();
   return m;
 }
 

@@ -20,6 +20,9 @@
 namespace acyclic::convert {
 
 configuration_t toMessage(const Configuration& q);
+// The same with the quaternion as it is, not normalized again: a solver's
+// knot, so that a trajectory made from it is the solver's, bit for bit.
+configuration_t toMessageAsIs(const Configuration& q);
 Configuration fromMessage(const configuration_t& m, const Scenario& sc, const std::string& origin);
 
 // A contact's spot, surface, support and placement (and its frame's world

@@ -9,18 +9,6 @@ namespace {
 
 std::string field(const std::string& base, std::size_t i) { return base + "[" + std::to_string(i) + "]"; }
 
-// toMessage(Configuration) normalizes the quaternion; a knot goes unchanged.
-configuration_t knotMessage(const Configuration& q) {
-  configuration_t m{};
-  for (int k = 0; k < 3; ++k) m.base_position[k] = q.base_position[k];
-  const Eigen::Quaterniond& o = q.base_orientation;
-  m.base_orientation[0] = o.w(), m.base_orientation[1] = o.x(), m.base_orientation[2] = o.y(),
-  m.base_orientation[3] = o.z();
-  m.num_joints = static_cast<int32_t>(q.joints.size());
-  m.joints.assign(q.joints.data(), q.joints.data() + q.joints.size());
-  return m;
-}
-
 }  // namespace
 
 transitions_t toMessage(const std::vector<RememberedTransition>& transitions, const InterpolatorOptions& options,
@@ -44,7 +32,7 @@ transitions_t toMessage(const std::vector<RememberedTransition>& transitions, co
       mp.stance = p.stance;
       for (const ContactSpec& c : p.contacts) mp.contacts.push_back(toMessage(c, sc));
       mp.num_contacts = static_cast<int32_t>(mp.contacts.size());
-      for (const Configuration& q : p.knots) mp.knots.push_back(knotMessage(q));
+      for (const Configuration& q : p.knots) mp.knots.push_back(toMessageAsIs(q));
       mp.num_knots = static_cast<int32_t>(mp.knots.size());
       mt.pieces.push_back(std::move(mp));
     }
