@@ -298,7 +298,7 @@ class PlannerService : public proc::Service {
           m = convert::toMessage(plan, *sc);
 #ifdef ACYCLIC_HAVE_INTERPOLATOR
           if (memo) {
-            const auto known = convert::transitionsToSend(plan, *sc, *memo);
+            const auto known = convert::transitionsToSend(m, *sc, *memo);
             if (!known.empty()) transitions = convert::toMessage(known, memo->options(), *sc);
           }
 #endif

@@ -82,11 +82,8 @@ std::size_t fillMemo(const transitions_t& m, const Plan& plan, const Scenario& s
   return read.size();
 }
 
-std::vector<RememberedTransition> transitionsToSend(const Plan& plan, const Scenario& sc, const TransitionMemo& memo) {
-  plan_t m = toMessage(plan, sc);
-  m.request_id = 0;
-  const Plan received = fromMessage(m, sc);
-  return rememberedTransitions(received, memo);
+std::vector<RememberedTransition> transitionsToSend(const plan_t& sent, const Scenario& sc, const TransitionMemo& memo) {
+  return rememberedTransitions(fromMessage(sent, sc), memo);
 }
 
 }  // namespace acyclic::convert

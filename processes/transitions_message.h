@@ -5,6 +5,7 @@
 // interpolator library.
 #include <vector>
 
+#include "acyclic/plan_t.hpp"
 #include "acyclic/transitions_t.hpp"
 #include "interpolator/transition_memo.h"
 
@@ -23,10 +24,10 @@ transitions_t toMessage(const std::vector<RememberedTransition>& transitions, co
 // scenario's robot and scene do not know. Returns how many were stored.
 std::size_t fillMemo(const transitions_t& m, const Plan& plan, const Scenario& sc, TransitionMemo& memo);
 
-// The transitions of `plan` the memo holds, as the interpolator will key
-// them in the plan it receives: `plan` sent as ACYCLIC_PLAN and read back.
-// A transition whose stances change on the way (a quaternion normalized
+// The transitions of the plan message `sent` that the memo holds, keyed as
+// the interpolator will key them in the plan it reads from that message. A
+// transition whose stances changed on the way (a quaternion normalized
 // again) is left out: its outcome was solved for other bits.
-std::vector<RememberedTransition> transitionsToSend(const Plan& plan, const Scenario& sc, const TransitionMemo& memo);
+std::vector<RememberedTransition> transitionsToSend(const plan_t& sent, const Scenario& sc, const TransitionMemo& memo);
 
 }  // namespace acyclic::convert
