@@ -238,6 +238,18 @@ PostureGenerator::PostureGenerator(std::shared_ptr<const RobotModel> robot, std:
 
 PostureGenerator::~PostureGenerator() = default;
 
+namespace {
+
+// A call solved a second time answers with the second solve, costed with
+// both: its solves, iterations and wall time.
+void countEarlierSolve(PostureResult& second, const PostureResult& first) {
+  second.solves += first.solves;
+  second.iterations += first.iterations;
+  second.seconds += first.seconds;
+}
+
+}  // namespace
+
 PostureResult PostureGenerator::solve(const PostureRequest& request, const std::atomic<bool>* stop) {
   PostureResult res = solveHeld(request, stop);
   if (res.success() || res.status == PostureResult::Status::BadInput ||
@@ -247,10 +259,8 @@ PostureResult PostureGenerator::solve(const PostureRequest& request, const std::
   again.initial_guess = *request.retry_guess;
   again.retry_guess.reset();
   PostureResult second = solveHeld(again, stop);
-  second.solves += res.solves;
   second.retried = true;
-  second.iterations += res.iterations;
-  second.seconds += res.seconds;
+  countEarlierSolve(second, res);
   return second;
 }
 
@@ -289,10 +299,8 @@ PostureResult PostureGenerator::solveHeld(const PostureRequest& request, const s
   PostureRequest turned = request;
   turned.floating->footprint_turned = true;
   PostureResult second = solveOnce(turned, stop);
-  second.solves += res.solves;
   second.footprint_turned = true;
-  second.iterations += res.iterations;
-  second.seconds += res.seconds;
+  countEarlierSolve(second, res);
   if (footprintOffTheSurface(turned, second, false)) {  // ended on the other branch: neither footprint held
     second.status = PostureResult::Status::Infeasible;
     second.reason = "the floating spot's footprint leaves its surface with its polygon held either way";
