@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <deque>
-#include <map>
 #include <memory>
+#include <optional>
 
 #include "acyclic/cancel_t.hpp"
 #include "acyclic/plan_t.hpp"
@@ -63,20 +63,22 @@ class InterpolatorService : public proc::Service {
   void onTransitions(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     transitions_t m;
     if (!proc::decode(rb, channel, m, status_)) return;
-    const std::int64_t id = m.request_id;
-    forgetTransitions(id);
-    transitions_.emplace(id, Kept{std::move(m), rb->data_size});
-    kept_bytes_ += rb->data_size;
-    arrival_.push_back(id);
-    while (arrival_.size() > kKeptTransitions || (arrival_.size() > 1 && kept_bytes_ > kKeptBytes))
-      forgetTransitions(arrival_.front());
+    take(m.request_id);  // a second message for a request replaces the first
+    kept_.push_back(Kept{std::move(m), rb->data_size});
+    auto bytes = [&] {
+      std::size_t n = 0;
+      for (const Kept& k : kept_) n += k.bytes;
+      return n;
+    };
+    while (kept_.size() > kKeptTransitions || (kept_.size() > 1 && bytes() > kKeptBytes)) kept_.pop_front();
   }
-  void forgetTransitions(std::int64_t id) {
-    const auto t = transitions_.find(id);
-    if (t == transitions_.end()) return;
-    kept_bytes_ -= t->second.bytes;
-    transitions_.erase(t);
-    arrival_.erase(std::remove(arrival_.begin(), arrival_.end(), id), arrival_.end());
+  // The transitions kept for request `id`, no longer kept (none: empty).
+  std::optional<transitions_t> take(std::int64_t id) {
+    const auto k = std::find_if(kept_.begin(), kept_.end(), [&](const Kept& x) { return x.message.request_id == id; });
+    if (k == kept_.end()) return std::nullopt;
+    std::optional<transitions_t> m = std::move(k->message);
+    kept_.erase(k);
+    return m;
   }
 
   // A memo of the planner's transitions for this plan, under these options;
@@ -85,10 +87,9 @@ class InterpolatorService : public proc::Service {
   // interpolated without them, to the same result).
   std::shared_ptr<TransitionMemo> plannersTransitions(std::int64_t id, const Plan& plan, const Scenario& sc,
                                                       const InterpolatorOptions& options) {
-    const auto t = transitions_.find(id);
-    if (t == transitions_.end()) return nullptr;
-    const transitions_t m = std::move(t->second.message);
-    forgetTransitions(id);
+    const std::optional<transitions_t> kept = take(id);
+    if (!kept) return nullptr;
+    const transitions_t& m = *kept;
     const std::string what = "request " + std::to_string(id) + ": the planner's " +
                              std::to_string(m.num_transitions) + " transitions (ACYCLIC_TRANSITIONS)";
     if (m.options != outcomeOptionsText(options)) {
@@ -198,9 +199,7 @@ class InterpolatorService : public proc::Service {
     std::size_t bytes;  // encoded
   };
   InterpolatorOptionsFor options_;
-  std::map<std::int64_t, Kept> transitions_;  // by request id
-  std::deque<std::int64_t> arrival_;          // their ids, oldest first
-  std::size_t kept_bytes_ = 0;
+  std::deque<Kept> kept_;  // the planner's transitions, oldest first
 };
 
 }  // namespace
